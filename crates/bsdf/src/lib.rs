@@ -1,0 +1,1 @@
+//! fenestra-bsdf (skeleton; see docs/architecture.md).

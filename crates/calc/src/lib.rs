@@ -1,0 +1,1 @@
+//! fenestra-calc (skeleton; see docs/architecture.md).

@@ -1,0 +1,1 @@
+//! fenestra-cli (skeleton; see docs/architecture.md).

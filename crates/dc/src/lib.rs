@@ -1,0 +1,1 @@
+//! fenestra-dc (skeleton; see docs/architecture.md).

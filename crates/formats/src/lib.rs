@@ -1,0 +1,1 @@
+//! fenestra-formats (skeleton; see docs/architecture.md).

@@ -1,0 +1,1 @@
+//! fenestra-scene (skeleton; see docs/architecture.md).

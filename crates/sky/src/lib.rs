@@ -1,0 +1,1 @@
+//! fenestra-sky (skeleton; see docs/architecture.md).

@@ -1,0 +1,1 @@
+//! fenestra-trace (skeleton; see docs/architecture.md).

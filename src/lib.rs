@@ -1,0 +1,4 @@
+//! fenestra: Radiance-compatible daylighting tools. Each tool's logic lives in
+//! [`tools`]; `src/bin/*.rs` only call [`fenestra_cli::main_with`].
+
+pub mod tools;

@@ -1,0 +1,1 @@
+//! Tool entry points (one module per tool).
