@@ -1,1 +1,12 @@
-//! Tool entry points (one module per tool).
+//! Tool entry points: one module per tool, each with
+//! `pub fn run(args: Vec<String>) -> anyhow::Result<ExitCode>`.
+
+use std::process::ExitCode;
+
+/// A tool's entry point.
+pub type Run = fn(Vec<String>) -> anyhow::Result<ExitCode>;
+
+/// Every tool by name (for the multicall `fenestra TOOL …` binary).
+pub fn registry() -> &'static [(&'static str, Run)] {
+    &[]
+}

@@ -1,1 +1,13 @@
-//! fenestra-cli (skeleton; see docs/architecture.md).
+//! Command-line conventions shared by every fenestra tool: Radiance-style options
+//! (`-ab 4`, `-faf`, `-vd x y z`, `+f`/`-f`, `@optfile`), RAYPATH look-up, inputs
+//! (`-`, `!command`), atomic output files, progress bars and error printing.
+
+pub mod expand;
+pub mod input;
+pub mod opts;
+pub mod output;
+pub mod progress;
+pub mod raypath;
+mod run;
+
+pub use run::{command_line, main_with, prog, set_prog, warn, Exit};

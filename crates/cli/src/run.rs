@@ -1,0 +1,123 @@
+//! The entry point wrapper every tool binary calls, program name and messages.
+
+use std::process::ExitCode;
+use std::sync::OnceLock;
+
+static PROG: OnceLock<String> = OnceLock::new();
+
+/// A request to end the program quietly with the given status (e.g. after `--help`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Exit(pub u8);
+
+impl std::fmt::Display for Exit {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "exit status {}", self.0)
+    }
+}
+
+impl std::error::Error for Exit {}
+
+/// Sets the program name used in messages (done by [`main_with`]; tests may call it).
+pub fn set_prog(name: &str) {
+    let base = std::path::Path::new(name)
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| name.to_string());
+    let _ = PROG.set(base);
+}
+
+/// The program name used in messages (`fenestra` until set).
+pub fn prog() -> &'static str {
+    PROG.get().map(String::as_str).unwrap_or("fenestra")
+}
+
+/// Prints `prog: warning - msg` on stderr, as Radiance tools do.
+pub fn warn(msg: impl std::fmt::Display) {
+    eprintln!("{}: warning - {}", prog(), msg);
+}
+
+/// Runs a tool: expands `@file`/`$VAR` arguments, sets the program name, and turns
+/// an error into `prog: fatal - message` with exit status 1.
+pub fn main_with(run: fn(Vec<String>) -> anyhow::Result<ExitCode>) -> ExitCode {
+    let raw: Vec<String> = std::env::args_os()
+        .map(|a| a.to_string_lossy().into_owned())
+        .collect();
+    if let Some(p) = raw.first() {
+        set_prog(p);
+    }
+    let args = match crate::expand::expand_args(raw) {
+        Ok(a) => a,
+        Err(e) => {
+            eprintln!("{}: fatal - {:#}", prog(), e);
+            return ExitCode::from(1);
+        }
+    };
+    match run(args) {
+        Ok(code) => code,
+        Err(e) => {
+            if let Some(Exit(code)) = e.downcast_ref::<Exit>() {
+                return ExitCode::from(*code);
+            }
+            if is_broken_pipe(&e) {
+                // A closed downstream pipe (e.g. `| head`) is not an error worth a message.
+                return ExitCode::from(1);
+            }
+            eprintln!("{}: fatal - {:#}", prog(), e);
+            ExitCode::from(1)
+        }
+    }
+}
+
+fn is_broken_pipe(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| {
+        c.downcast_ref::<std::io::Error>()
+            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+    })
+}
+
+/// Formats arguments as Radiance's `printargs` writes a command line into a header:
+/// words separated by one space, a word quoted when empty or containing white space.
+pub fn command_line(args: &[String]) -> String {
+    let mut out = String::new();
+    for (i, a) in args.iter().enumerate() {
+        if i > 0 {
+            out.push(' ');
+        }
+        let word = if i == 0 {
+            std::path::Path::new(a)
+                .file_name()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| a.clone())
+        } else {
+            a.clone()
+        };
+        out.push_str(&quote_word(&word));
+    }
+    out
+}
+
+fn quote_word(w: &str) -> String {
+    let needs = w.is_empty() || w.chars().any(|c| c.is_whitespace());
+    if !needs {
+        return w.to_string();
+    }
+    if w.contains('"') {
+        format!("'{w}'")
+    } else {
+        format!("\"{w}\"")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn command_line_quotes_words_with_spaces() {
+        let args: Vec<String> = ["/usr/bin/rmtxop", "-c", "a b", "", "x\"y z"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        assert_eq!(command_line(&args), "rmtxop -c \"a b\" \"\" 'x\"y z'");
+    }
+}

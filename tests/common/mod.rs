@@ -1,0 +1,102 @@
+//! Helpers shared by the integration tests: our binaries, the reference
+//! implementation (oracle), fixtures and scratch folders.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The reference Radiance binaries (PyPI pyradiance 1.3.1, Radiance 6.0a).
+pub struct Oracle {
+    bin: PathBuf,
+    lib: PathBuf,
+}
+
+impl Oracle {
+    /// Path of an oracle binary.
+    pub fn bin(&self, name: &str) -> PathBuf {
+        self.bin.join(name)
+    }
+
+    /// The oracle's library folder (its .cal files).
+    pub fn lib(&self) -> &Path {
+        &self.lib
+    }
+
+    /// A command running an oracle binary with PATH and RAYPATH pointing at the oracle.
+    pub fn command(&self, name: &str) -> Command {
+        let mut c = Command::new(self.bin(name));
+        let path = std::env::var("PATH").unwrap_or_default();
+        c.env("PATH", format!("{}:{}", self.bin.display(), path));
+        c.env("RAYPATH", format!(".:{}", self.lib.display()));
+        c
+    }
+}
+
+fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The oracle, found through FENESTRA_ORACLE_BIN/FENESTRA_ORACLE_LIB or the
+/// `.oracle/env` file written by `scripts/oracle.sh`. Missing: `None` with a note,
+/// except under CI (`CI=true`), where a missing oracle fails the test.
+pub fn oracle() -> Option<Oracle> {
+    let mut bin = std::env::var_os("FENESTRA_ORACLE_BIN").map(PathBuf::from);
+    let mut lib = std::env::var_os("FENESTRA_ORACLE_LIB").map(PathBuf::from);
+    if bin.is_none() {
+        if let Ok(text) = std::fs::read_to_string(repo().join(".oracle/env")) {
+            for line in text.lines() {
+                if let Some(v) = line.strip_prefix("FENESTRA_ORACLE_BIN=") {
+                    bin = Some(PathBuf::from(v));
+                } else if let Some(v) = line.strip_prefix("FENESTRA_ORACLE_LIB=") {
+                    lib = Some(PathBuf::from(v));
+                }
+            }
+        }
+    }
+    match (bin, lib) {
+        (Some(b), Some(l)) if b.join("rmtxop").is_file() => Some(Oracle { bin: b, lib: l }),
+        _ => {
+            if std::env::var("CI").is_ok_and(|v| v == "true") {
+                panic!("the reference implementation is required under CI: run scripts/oracle.sh");
+            }
+            eprintln!("note: reference implementation not found (run scripts/oracle.sh); differential test skipped");
+            None
+        }
+    }
+}
+
+/// A command running one of our binaries (built by cargo for the integration tests).
+pub fn fenestra(name: &str) -> Command {
+    let exe = std::env::current_exe().expect("test executable path");
+    // target/<profile>/deps/<test> → target/<profile>/<name>
+    let dir = exe.parent().and_then(Path::parent).expect("target folder");
+    let mut c = Command::new(dir.join(name));
+    c.env("FENESTRA_LIB", repo().join("lib"));
+    c.env("FENESTRA_NO_PROGRESS", "1");
+    c
+}
+
+/// A file or folder under `tests/fixtures/`.
+pub fn fixture(rel: &str) -> PathBuf {
+    repo().join("tests/fixtures").join(rel)
+}
+
+/// A fresh scratch folder for one test.
+pub fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("fenestra-test-{}-{}", name, std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("scratch folder");
+    d
+}
+
+/// Runs a command, asserting success, and returns its stdout.
+pub fn run_ok(cmd: &mut Command) -> Vec<u8> {
+    let out = cmd.output().unwrap_or_else(|e| panic!("cannot run {cmd:?}: {e}"));
+    assert!(
+        out.status.success(),
+        "{cmd:?} failed ({}): {}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out.stdout
+}
