@@ -5,4 +5,4 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ -f .oracle/env ]; then set -a; . .oracle/env; set +a; fi
-cargo test --workspace --release oracle_ "$@"
+cargo test --workspace --profile testopt oracle_ "$@"

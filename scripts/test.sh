@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs fenestra's tests (unit, property, command-line and, when the reference
 # implementation is installed by scripts/oracle.sh, differential tests).
-# Release mode: the numeric tests are heavy.
+# Optimised build (profile testopt): the numeric tests are heavy.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cargo test --workspace --release "$@"
+cargo test --workspace --profile testopt "$@"
