@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# fenestra example: a three-phase annual run on the bundled office (south window with a venetian blind).
+#
+#   sky matrix s   gendaymtx -m 1 weather/sf_year.wea                     (146 Reinhart patches x 8760 hours)
+#   time step      dctimestep V blinds_kf.xml D s | rmtxop -c … (lux)     (45 sensors x 8760 hours)
+#   metrics        per sensor: daylight autonomy (share of working hours 8-18 h with >= 300 lux), mean lux
+#
+# V (room → window, Klems) and D (window → sky, Reinhart MF 1) are the matrices in matrices/ (see
+# matrices/README.md for how they were made); the scene they describe is in scene/.
+# Usage: examples/three-phase/run.sh   (OUT=dir to choose where results go; FENESTRA_BIN=dir to use
+# already-built binaries instead of building them)
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+top=$(cd "$here/../.." && pwd)
+if [ -z "${FENESTRA_BIN:-}" ]; then
+  echo "== building fenestra (cargo build --release)" >&2
+  cargo build --release --quiet --manifest-path "$top/Cargo.toml" --bins
+  target=$(cargo metadata --format-version 1 --no-deps --manifest-path "$top/Cargo.toml" |
+    sed -n 's/.*"target_directory":"\([^"]*\)".*/\1/p')
+  FENESTRA_BIN="$target/release"
+fi
+export PATH="$FENESTRA_BIN:$PATH"
+out=${OUT:-$here/out}
+mkdir -p "$out"
+cd "$here"
+
+start=$(date +%s.%N)
+echo "== sky matrix: gendaymtx -m 1 weather/sf_year.wea" >&2
+gendaymtx -m 1 weather/sf_year.wea > "$out/sky.smx"
+echo "== time step: dctimestep V blinds_kf.xml D sky | rmtxop -c 47.435 119.93 11.635 (lux)" >&2
+dctimestep matrices/V.vmx matrices/blinds_kf.xml matrices/D.dmx "$out/sky.smx" |
+  rmtxop -fa -c 47.435 119.93 11.635 - > "$out/ill.dat"
+end=$(date +%s.%N)
+
+echo "== annual metrics per sensor (working hours 8-18 h local standard time)"
+# Column k of ill.dat is hour k of the weather file; keep the working ones.
+awk -v WEA=weather/sf_year.wea -v PTS=scene/sensors.pts '
+  BEGIN {
+    n = 0
+    while ((getline line < WEA) > 0) {
+      split(line, f, /[ \t]+/)
+      if (f[1] ~ /^[0-9]+$/ && f[2] ~ /^[0-9]+$/ && f[3] != "") { n++; work[n] = (f[3] >= 8 && f[3] < 18) }
+    }
+    s = 0
+    while ((getline line < PTS) > 0) { split(line, p, /[ \t]+/); s++; px[s] = p[1]; py[s] = p[2] }
+    printf "%-7s %6s %6s %10s %10s\n", "sensor", "x", "y", "DA300 %", "mean lux"
+    body = 0; row = 0
+  }
+  body == 0 { if ($0 == "") body = 1; next }
+  NF > 0 {
+    row++; nw = 0; above = 0; sum = 0
+    for (k = 1; k <= NF; k++) if (work[k]) { nw++; sum += $k; if ($k >= 300) above++ }
+    if (NF != n) { printf "run.sh: %d values for sensor %d, expected %d hours\n", NF, row, n > "/dev/stderr"; exit 1 }
+    printf "%-7d %6.2f %6.2f %10.1f %10.1f\n", row, px[row], py[row], 100 * above / nw, sum / nw
+    da += above / nw
+  }
+  END { if (row) printf "room: mean DA300 %.1f %% over %d sensors\n", 100 * da / row, row }
+' "$out/ill.dat"
+awk -v a="$start" -v b="$end" -v o="$out" 'BEGIN { printf "time for sky matrix + time step: %.2f s (results in %s)\n", b - a, o }'
