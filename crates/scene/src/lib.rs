@@ -1,1 +1,14 @@
-//! fenestra-scene (skeleton; see docs/architecture.md).
+//! fenestra-scene: the scene model shared by every tracing tool, parsers for Radiance
+//! scene descriptions (`.rad`, with `!command` lines, aliases and `void`) and MGF, the
+//! `xform` transforms, and fenestra's compiled-scene format (written by `oconv`).
+
+pub mod cfmt;
+pub mod compiled;
+mod model;
+mod rad;
+pub mod types;
+mod words;
+
+pub use model::{Loc, Primitive, Scene};
+pub use rad::{load, parse_str, Parser};
+pub use words::parse_real;

@@ -1,0 +1,420 @@
+//! The Radiance scene-description parser (`.rad`): primitives, `void`, `alias`,
+//! statement comments and `!command` lines.
+
+use std::fmt::Write as _;
+use std::process::{Command, Stdio};
+use std::sync::Arc;
+
+use anyhow::{anyhow, bail, Context, Result};
+
+use crate::model::{Loc, Primitive, Scene};
+use crate::words::{parse_count, parse_real, Words};
+
+/// Builds a [`Scene`] from several inputs; modifiers resolve across inputs in order.
+#[derive(Debug, Default)]
+pub struct Parser {
+    scene: Scene,
+}
+
+/// How deep `!command` output may itself run commands.
+const MAX_COMMAND_DEPTH: usize = 32;
+
+impl Parser {
+    /// An empty parser.
+    pub fn new() -> Self {
+        Parser::default()
+    }
+
+    /// The scene read so far.
+    pub fn finish(self) -> Scene {
+        self.scene
+    }
+
+    /// The scene read so far, by reference.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// Reads one input: `-` is standard input, a name ending in `.mgf` is MGF, anything
+    /// else Radiance scene text.
+    pub fn add_path(&mut self, path: &str) -> Result<()> {
+        if path == "-" {
+            let mut text = String::new();
+            std::io::Read::read_to_string(&mut std::io::stdin(), &mut text)
+                .context("cannot read the scene from standard input")?;
+            return self.add_str(&text, "-");
+        }
+        let text = read_text(path)?;
+        self.add_str(&text, path)
+    }
+
+    /// Appends primitives produced by a converter (MGF), resolving their modifiers by name.
+    #[allow(dead_code)]
+    pub(crate) fn add_converted(&mut self, prims: Vec<Primitive>) -> Result<()> {
+        for mut p in prims {
+            p.modifier = self.resolve_modifier(&p.modifier_name, &p.loc, &p.ptype, &p.name)?;
+            self.scene.prims.push(p);
+        }
+        Ok(())
+    }
+
+    /// Reads Radiance scene text; `file` names it in locations and messages.
+    pub fn add_str(&mut self, text: &str, file: &str) -> Result<()> {
+        self.add_text(text, Arc::from(file), 0)
+    }
+
+    fn add_text(&mut self, text: &str, file: Arc<str>, depth: usize) -> Result<()> {
+        let mut w = Words::new(text);
+        while let Some(c) = w.skip_space() {
+            let line = w.line();
+            let loc = Loc {
+                file: file.clone(),
+                line,
+            };
+            match c {
+                b'#' => {
+                    w.rest_of_line();
+                }
+                b'!' => {
+                    let (cmd, open) = w.command();
+                    if open {
+                        bail!("{loc}: unterminated !command (the last line ends with '\\' at end of input): !{cmd}");
+                    }
+                    self.run_command(&cmd, &loc, depth)?;
+                }
+                _ => self.primitive(&mut w, &loc)?,
+            }
+        }
+        Ok(())
+    }
+
+    fn run_command(&mut self, cmd: &str, loc: &Loc, depth: usize) -> Result<()> {
+        if depth >= MAX_COMMAND_DEPTH {
+            bail!("{loc}: !commands nested more than {MAX_COMMAND_DEPTH} deep: !{cmd}");
+        }
+        let out = command_output(cmd).with_context(|| format!("{loc}: !{cmd}"))?;
+        let name: Arc<str> = Arc::from(format!("!{}", short_command(cmd)));
+        self.add_text(&out, name, depth + 1)
+            .with_context(|| format!("in the output of the !command at {loc}"))
+    }
+
+    fn primitive(&mut self, w: &mut Words, loc: &Loc) -> Result<()> {
+        let word = |w: &mut Words, what: &str| -> Result<String> {
+            match w.word() {
+                Ok(Some(s)) => Ok(s),
+                Ok(None) => Err(anyhow!("{loc}: unexpected end of input, expected {what}")),
+                Err(e) => Err(anyhow!("{loc}: {e}")),
+            }
+        };
+        let modifier_name = word(w, "a modifier name")?;
+        let ptype = word(
+            w,
+            &format!("a primitive type after modifier '{modifier_name}'"),
+        )?;
+        let name = word(w, &format!("an identifier after '{modifier_name} {ptype}'"))?;
+        if ptype == "alias" {
+            let target = word(w, &format!("the name aliased by '{name}'"))?;
+            return self.alias(modifier_name, name, target, loc);
+        }
+        let rule = crate::types::rule(&ptype).ok_or_else(|| {
+            anyhow!(
+                "{loc}: unknown primitive type '{ptype}' (for '{modifier_name} {ptype} {name}')"
+            )
+        })?;
+        let what = format!("{} {}", rule.name, name);
+        let count = |w: &mut Words, kind: &str| -> Result<usize> {
+            let s = word(w, &format!("the {kind}-argument count of {what}"))?;
+            parse_count(&s).ok_or_else(|| {
+                anyhow!("{loc}: {what}: expected the {kind}-argument count, got '{s}'")
+            })
+        };
+        let ns = count(w, "string")?;
+        let mut sargs = Vec::with_capacity(ns);
+        for k in 0..ns {
+            sargs.push(word(
+                w,
+                &format!("string argument {} of {ns} of {what}", k + 1),
+            )?);
+        }
+        let ni = count(w, "integer")?;
+        let mut iargs = Vec::with_capacity(ni);
+        for k in 0..ni {
+            iargs.push(word(
+                w,
+                &format!("integer argument {} of {ni} of {what}", k + 1),
+            )?);
+        }
+        let nr = count(w, "real")?;
+        let mut rargs = Vec::with_capacity(nr);
+        for k in 0..nr {
+            let s = word(w, &format!("real argument {} of {nr} of {what}", k + 1))?;
+            let v = parse_real(&s).ok_or_else(|| {
+                anyhow!(
+                    "{loc}: {what}: real argument {} is not a number: '{s}'",
+                    k + 1
+                )
+            })?;
+            rargs.push(v);
+        }
+        crate::types::check(&ptype, ns, ni, nr).map_err(|e| anyhow!("{loc}: {what}: {e}"))?;
+        let modifier = self.resolve_modifier(&modifier_name, loc, &ptype, &name)?;
+        self.scene.prims.push(Primitive {
+            modifier,
+            modifier_name,
+            ptype,
+            name,
+            sargs,
+            iargs,
+            rargs,
+            loc: loc.clone(),
+        });
+        Ok(())
+    }
+
+    fn resolve_modifier(
+        &self,
+        modifier_name: &str,
+        loc: &Loc,
+        ptype: &str,
+        name: &str,
+    ) -> Result<Option<usize>> {
+        if modifier_name == "void" {
+            return Ok(None);
+        }
+        match self
+            .scene
+            .find_modifier(modifier_name, self.scene.prims.len())
+        {
+            Some(i) => Ok(Some(i)),
+            None => bail!("{loc}: undefined modifier '{modifier_name}' (used by {ptype} '{name}')"),
+        }
+    }
+
+    /// `modifier alias newid oldid`: a copy of modifier `oldid` named `newid`, modified
+    /// by `modifier` (or by `oldid`'s own modifier when `modifier` is `inherit`).
+    fn alias(
+        &mut self,
+        modifier_name: String,
+        name: String,
+        target: String,
+        loc: &Loc,
+    ) -> Result<()> {
+        let n = self.scene.prims.len();
+        let t = self.scene.find_modifier(&target, n).ok_or_else(|| {
+            anyhow!("{loc}: alias '{name}' refers to undefined modifier '{target}'")
+        })?;
+        let orig = &self.scene.prims[t];
+        let (modifier, modifier_name) = if modifier_name == "inherit" {
+            (orig.modifier, orig.modifier_name.clone())
+        } else {
+            let m = self.resolve_modifier(&modifier_name, loc, "alias", &name)?;
+            (m, modifier_name)
+        };
+        let p = Primitive {
+            modifier,
+            modifier_name,
+            ptype: orig.ptype.clone(),
+            name,
+            sargs: orig.sargs.clone(),
+            iargs: orig.iargs.clone(),
+            rargs: orig.rargs.clone(),
+            loc: loc.clone(),
+        };
+        self.scene.prims.push(p);
+        Ok(())
+    }
+}
+
+/// A command shortened for use as a location's file name.
+fn short_command(cmd: &str) -> String {
+    let one: String = cmd.split_whitespace().collect::<Vec<_>>().join(" ");
+    if one.chars().count() > 60 {
+        let s: String = one.chars().take(57).collect();
+        format!("{s}...")
+    } else {
+        one
+    }
+}
+
+/// Runs `cmd` through `sh -c` and returns its standard output; a failing command is an error.
+fn command_output(cmd: &str) -> Result<String> {
+    let out = Command::new("sh")
+        .arg("-c")
+        .arg(cmd)
+        .stdin(Stdio::null())
+        .stderr(Stdio::inherit())
+        .output()
+        .context("cannot run sh")?;
+    if !out.status.success() {
+        bail!("command failed ({})", out.status);
+    }
+    String::from_utf8(out.stdout).map_err(|_| anyhow!("command output is not UTF-8 text"))
+}
+
+/// Reads a text file, with an error naming it; a Radiance octree gets a specific message.
+pub(crate) fn read_text(path: &str) -> Result<String> {
+    let bytes = std::fs::read(path).with_context(|| format!("cannot open scene file '{path}'"))?;
+    if crate::compiled::is_radiance_octree(&bytes) {
+        bail!("{path}: this is an octree written by Radiance's oconv, which fenestra cannot read; pass the .rad files instead");
+    }
+    if crate::compiled::is_compiled(&bytes) {
+        bail!("{path}: this is a compiled scene (fenestra oconv output), not scene text; load it with fenestra_scene::compiled::read");
+    }
+    String::from_utf8(bytes).map_err(|_| anyhow!("{path}: not a text file (invalid UTF-8)"))
+}
+
+/// Parses Radiance scene text into a scene; `file` names it in messages.
+pub fn parse_str(text: &str, file: &str) -> Result<Scene> {
+    let mut p = Parser::new();
+    p.add_str(text, file)?;
+    Ok(p.finish())
+}
+
+/// Loads and concatenates scene inputs (`.rad` or anything else as Radiance text, `.mgf`
+/// as MGF, `-` for standard input); modifiers resolve across files in order.
+pub fn load(paths: &[&str]) -> Result<Scene> {
+    let mut p = Parser::new();
+    for path in paths {
+        p.add_path(path)?;
+    }
+    Ok(p.finish())
+}
+
+/// Formats a real as C's `%g` does (6 significant digits).
+pub(crate) fn fmt_g(v: f64, prec: usize) -> String {
+    crate::cfmt::g(v, prec)
+}
+
+/// Appends one primitive in Radiance syntax.
+pub(crate) fn write_primitive(s: &mut String, p: &Primitive) {
+    let _ = writeln!(s, "\n{} {} {}", p.modifier_name, p.ptype, p.name);
+    let _ = write!(s, "{}", p.sargs.len());
+    for a in &p.sargs {
+        let _ = write!(s, " {}", quote(a));
+    }
+    let _ = write!(s, "\n{}", p.iargs.len());
+    for a in &p.iargs {
+        let _ = write!(s, " {a}");
+    }
+    let _ = write!(s, "\n{}", p.rargs.len());
+    for v in &p.rargs {
+        let _ = write!(s, " {}", fmt_g(*v, 17));
+    }
+    s.push('\n');
+}
+
+fn quote(w: &str) -> String {
+    if w.is_empty() || w.chars().any(|c| c.is_whitespace()) {
+        if w.contains('"') {
+            format!("'{w}'")
+        } else {
+            format!("\"{w}\"")
+        }
+    } else {
+        w.to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SCENE: &str = "# a comment\nvoid plastic red 0 0 5 .5 .1 .1 0 0\n\
+red polygon p1 0 0 12 0 0 0 1 0 0 1 1 0 0 1 0\n\
+void brightfunc sky 2 skybr skybright.cal 0 7 1 2 3 4 5 6 7\n\
+sky glow g 0 0 4 1 1 1 0\ng source sun 0 0 4 0 0 1 180\n\
+sky alias red2 red\ninherit alias red3 red\nred2 \"sphere\" s 0 0 4 1 2 3 .5\n";
+
+    #[test]
+    fn parses_and_resolves() {
+        let s = parse_str(SCENE, "t.rad").unwrap();
+        assert_eq!(s.prims.len(), 8);
+        assert_eq!(s.prims[1].modifier, Some(0));
+        assert_eq!(s.prims[1].rargs.len(), 12);
+        assert_eq!(s.prims[1].loc.line, 3);
+        assert_eq!(s.prims[4].modifier, Some(3));
+        assert_eq!(s.prims[5].ptype, "plastic");
+        assert_eq!(s.prims[5].modifier, Some(2));
+        assert_eq!(s.prims[6].modifier, None);
+        assert_eq!(s.prims[7].modifier, Some(5));
+        assert_eq!(s.prims[7].ptype, "sphere");
+        assert_eq!(s.prims[2].sargs, vec!["skybr", "skybright.cal"]);
+    }
+
+    #[test]
+    fn most_recent_definition_wins() {
+        let t = "void plastic m 0 0 5 1 1 1 0 0\nm polygon m 0 0 9 0 0 0 1 0 0 0 1 0\n\
+void metal m 0 0 5 1 1 1 0 0\nm sphere s 0 0 4 0 0 0 1\n";
+        let s = parse_str(t, "t").unwrap();
+        assert_eq!(s.prims[1].modifier, Some(0));
+        assert_eq!(s.prims[3].modifier, Some(2));
+    }
+
+    #[test]
+    fn errors_name_file_and_line() {
+        let cases = [
+            (
+                "void plastic m 0 0 4 1 1 1 0\n",
+                "t.rad:1",
+                "real arguments",
+            ),
+            (
+                "\n\nfoo polygon p 0 0 9 0 0 0 1 0 0 0 1 0\n",
+                "t.rad:3",
+                "undefined modifier 'foo'",
+            ),
+            (
+                "void blob b 0 0 0\n",
+                "t.rad:1",
+                "unknown primitive type 'blob'",
+            ),
+            (
+                "void plastic m 0 0 5 1 1 x 0 0\n",
+                "t.rad:1",
+                "not a number",
+            ),
+            ("void plastic m 0 0 5 1 1\n", "t.rad:1", "end of input"),
+            ("!echo a \\", "t.rad:1", "unterminated !command"),
+            ("\n!exit 3\n", "t.rad:2", "command failed"),
+            (
+                "void plastic m 1 x 0 5 1 1 1 0 0\n",
+                "t.rad:1",
+                "string arguments",
+            ),
+            (
+                "void alias a nothing\n",
+                "t.rad:1",
+                "undefined modifier 'nothing'",
+            ),
+        ];
+        for (text, at, what) in cases {
+            let e = format!("{:#}", parse_str(text, "t.rad").unwrap_err());
+            assert!(e.contains(at) && e.contains(what), "{text:?} → {e}");
+        }
+    }
+
+    #[test]
+    fn commands_are_run() {
+        let t = "void plastic m 0 0 5 1 1 1 0 0\n!echo m sphere s 0 0 4 0 0 0 1\n";
+        let s = parse_str(t, "t").unwrap();
+        assert_eq!(s.prims.len(), 2);
+        assert_eq!(&*s.prims[1].loc.file, "!echo m sphere s 0 0 4 0 0 0 1");
+        let e = format!(
+            "{:#}",
+            parse_str("!echo m sphere s 0 0 4 0 0 0 1\n", "t").unwrap_err()
+        );
+        assert!(e.contains("t:1") && e.contains("undefined modifier"), "{e}");
+    }
+
+    #[test]
+    fn round_trip_through_text() {
+        let s = parse_str(SCENE, "t").unwrap();
+        let again = parse_str(&s.to_rad(), "t").unwrap();
+        for (a, b) in s.prims.iter().zip(&again.prims) {
+            assert_eq!(
+                (&a.ptype, &a.name, &a.sargs, &a.rargs),
+                (&b.ptype, &b.name, &b.sargs, &b.rargs)
+            );
+        }
+    }
+}
