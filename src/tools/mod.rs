@@ -3,10 +3,12 @@
 
 use std::process::ExitCode;
 
+pub mod gendaymtx;
+
 /// A tool's entry point.
 pub type Run = fn(Vec<String>) -> anyhow::Result<ExitCode>;
 
 /// Every tool by name (for the multicall `fenestra TOOL …` binary).
 pub fn registry() -> &'static [(&'static str, Run)] {
-    &[]
+    &[("gendaymtx", gendaymtx::run)]
 }

@@ -1,1 +1,9 @@
-//! fenestra-sky (skeleton; see docs/architecture.md).
+//! fenestra-sky: solar position, CIE skies (gensky), the Perez all-weather sky
+//! (gendaymtx, gendaylit), the Reinhart patch basis and sky vectors (genskyvec).
+
+pub mod cie;
+pub mod daymtx;
+pub mod patches;
+pub mod perez;
+pub mod solar;
+pub mod weather;
