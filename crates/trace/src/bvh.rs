@@ -1,0 +1,363 @@
+//! The acceleration structure: an obvhs compressed-wide BVH over f32 boxes rounded
+//! outward, with every primitive test done in f64.
+//!
+//! Boxes are padded by a margin that covers the rounding of the f32 ray (origin and
+//! direction) used for traversal, so a surface the f64 test would hit is never culled.
+
+use glam::{DVec3, Vec3A};
+use obvhs::{aabb::Aabb, cwbvh::CwBvh, ray::Ray, Boundable, BvhBuildParams};
+
+use crate::shape::Shape;
+
+/// A closest-hit result.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hit {
+    /// Index of the shape in the accelerator's list.
+    pub shape: usize,
+    /// Distance along the (unit) ray.
+    pub t: f64,
+}
+
+struct BoxPrim(Aabb);
+
+impl Boundable for BoxPrim {
+    fn aabb(&self) -> Aabb {
+        self.0
+    }
+}
+
+/// Shapes with their BVH.
+pub struct Accel {
+    /// The shapes, indexed as the caller gave them.
+    pub shapes: Vec<Shape>,
+    bvh: Option<CwBvh>,
+    /// Below this many shapes a linear scan is used.
+    linear: bool,
+    /// Largest absolute coordinate of the scene (for relative epsilons).
+    pub scale: f64,
+}
+
+fn down(x: f64) -> f32 {
+    let f = x as f32;
+    if (f as f64) > x {
+        f.next_down()
+    } else {
+        f
+    }
+}
+
+fn up(x: f64) -> f32 {
+    let f = x as f32;
+    if (f as f64) < x {
+        f.next_up()
+    } else {
+        f
+    }
+}
+
+impl Accel {
+    /// Builds the BVH over `shapes`.
+    pub fn new(shapes: Vec<Shape>) -> Accel {
+        let bounds: Vec<(DVec3, DVec3)> = shapes.iter().map(Shape::bounds).collect();
+        let mut scale: f64 = 1.0;
+        for (lo, hi) in &bounds {
+            scale = scale
+                .max(lo.abs().max_element())
+                .max(hi.abs().max_element());
+        }
+        let pad = 2e-6 * scale;
+        let prims: Vec<BoxPrim> = bounds
+            .iter()
+            .map(|(lo, hi)| {
+                let lo = *lo - DVec3::splat(pad);
+                let hi = *hi + DVec3::splat(pad);
+                BoxPrim(Aabb::new(
+                    Vec3A::new(down(lo.x), down(lo.y), down(lo.z)),
+                    Vec3A::new(up(hi.x), up(hi.y), up(hi.z)),
+                ))
+            })
+            .collect();
+        let linear = shapes.len() < 4;
+        let bvh = (!linear).then(|| {
+            obvhs::cwbvh::builder::build_cwbvh(
+                &prims,
+                BvhBuildParams::medium_build(),
+                &mut std::time::Duration::default(),
+            )
+        });
+        Accel {
+            shapes,
+            bvh,
+            linear,
+            scale,
+        }
+    }
+
+    /// Closest hit in (tmin, tmax) for a unit direction, skipping shape `skip`.
+    /// Ties at equal distance go to the lower shape index (Radiance's scene order).
+    pub fn closest(
+        &self,
+        org: DVec3,
+        dir: DVec3,
+        tmin: f64,
+        tmax: f64,
+        skip: Option<usize>,
+    ) -> Option<Hit> {
+        let mut best: Option<Hit> = None;
+        let test = |i: usize, best: &mut Option<Hit>| {
+            if Some(i) == skip {
+                return;
+            }
+            let lim = best.map_or(tmax, |b| b.t);
+            // allow an exact tie through so the lower index can win
+            let lim_incl = if lim.is_finite() {
+                lim * (1.0 + 1e-15) + 1e-300
+            } else {
+                lim
+            };
+            if let Some(t) = self.shapes[i].intersect(org, dir, tmin, lim_incl) {
+                match best {
+                    Some(b) if t > b.t || (t == b.t && i > b.shape) => {}
+                    _ => *best = Some(Hit { shape: i, t }),
+                }
+            }
+        };
+        match &self.bvh {
+            None => {
+                if self.linear {
+                    for i in 0..self.shapes.len() {
+                        test(i, &mut best);
+                    }
+                }
+            }
+            Some(bvh) => {
+                let ray = Ray::new(
+                    Vec3A::new(org.x as f32, org.y as f32, org.z as f32),
+                    // +0.0 turns -0.0 into 0.0: obvhs inverts the sign of a zero
+                    // component but tests `< 0`, so -0.0 would miss every box.
+                    Vec3A::new(dir.x as f32 + 0.0, dir.y as f32 + 0.0, dir.z as f32 + 0.0),
+                    0.0,
+                    if tmax.is_finite() {
+                        up(tmax * (1.0 + 1e-6) + 4e-6 * self.scale)
+                    } else {
+                        f32::INFINITY
+                    },
+                );
+                let mut rh = obvhs::ray::RayHit::none();
+                bvh.ray_traverse(ray, &mut rh, |_r, id| {
+                    let i = bvh.primitive_indices[id] as usize;
+                    test(i, &mut best);
+                    match best {
+                        Some(b) => up(b.t * (1.0 + 1e-6) + 4e-6 * self.scale),
+                        None => f32::INFINITY,
+                    }
+                });
+            }
+        }
+        best
+    }
+
+    /// Number of shapes.
+    pub fn len(&self) -> usize {
+        self.shapes.len()
+    }
+
+    /// Whether there are no shapes.
+    pub fn is_empty(&self) -> bool {
+        self.shapes.is_empty()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::polygon::Polygon;
+
+    pub fn quad(c: DVec3, hx: f64, hy: f64) -> Shape {
+        Shape::Polygon(
+            Polygon::new(vec![
+                c + DVec3::new(-hx, -hy, 0.0),
+                c + DVec3::new(hx, -hy, 0.0),
+                c + DVec3::new(hx, hy, 0.0),
+                c + DVec3::new(-hx, hy, 0.0),
+            ])
+            .unwrap()
+            .0,
+        )
+    }
+
+    #[test]
+    fn bvh_matches_linear_scan() {
+        let mut shapes = Vec::new();
+        for i in 0..200 {
+            let f = i as f64;
+            shapes.push(quad(
+                DVec3::new((f * 0.37).sin() * 5.0, (f * 0.71).cos() * 5.0, f * 0.05),
+                0.3,
+                0.2,
+            ));
+        }
+        let acc = Accel::new(shapes.clone());
+        let mut nhit = 0;
+        for k in 0..500 {
+            let f = k as f64;
+            let org = DVec3::new((f * 0.13).sin() * 6.0, (f * 0.29).cos() * 6.0, 20.0);
+            let dir = DVec3::new((f * 0.07).sin() * 0.2, (f * 0.11).cos() * 0.2, -1.0).normalize();
+            let want = shapes
+                .iter()
+                .enumerate()
+                .filter_map(|(i, s)| s.intersect(org, dir, 0.0, f64::INFINITY).map(|t| (t, i)))
+                .min_by(|a, b| a.partial_cmp(b).unwrap());
+            let got = acc
+                .closest(org, dir, 0.0, f64::INFINITY, None)
+                .map(|h| (h.t, h.shape));
+            assert_eq!(got, want, "ray {k}");
+            nhit += usize::from(got.is_some());
+        }
+        assert!(nhit > 50, "{nhit}");
+    }
+
+    #[test]
+    fn coplanar_overlap_goes_to_first_in_scene_order() {
+        let shapes: Vec<Shape> = (0..6).map(|_| quad(DVec3::ZERO, 1.0, 1.0)).collect();
+        let acc = Accel::new(shapes);
+        let h = acc
+            .closest(
+                DVec3::new(0.2, 0.3, 1.0),
+                -DVec3::Z,
+                0.0,
+                f64::INFINITY,
+                None,
+            )
+            .unwrap();
+        assert_eq!(h.shape, 0);
+        let h = acc
+            .closest(
+                DVec3::new(0.2, 0.3, 1.0),
+                -DVec3::Z,
+                0.0,
+                f64::INFINITY,
+                Some(0),
+            )
+            .unwrap();
+        assert_eq!(h.shape, 1);
+    }
+
+    #[test]
+    fn grazing_rays_give_no_nan_and_consistent_answers() {
+        let acc = Accel::new(vec![quad(DVec3::ZERO, 1.0, 1.0); 5]);
+        for k in 0..50 {
+            let ang = 1e-6 * k as f64 / 50.0;
+            let dir = DVec3::new(ang.cos(), 0.0, -ang.sin());
+            let h = acc.closest(DVec3::new(-0.5, 0.0, 1e-7), dir, 0.0, f64::INFINITY, None);
+            if let Some(h) = h {
+                assert!(h.t.is_finite() && h.t > 0.0);
+                let p = DVec3::new(-0.5, 0.0, 1e-7) + dir * h.t;
+                assert!(p.x <= 1.0 + 1e-9, "{p}");
+            }
+        }
+        // exactly parallel in the plane: a miss, not a NaN
+        assert!(acc
+            .closest(
+                DVec3::new(-2.0, 0.0, 0.0),
+                DVec3::X,
+                0.0,
+                f64::INFINITY,
+                None
+            )
+            .is_none());
+    }
+
+    #[test]
+    fn ray_starting_on_a_surface() {
+        let acc = Accel::new(vec![
+            quad(DVec3::ZERO, 1.0, 1.0),
+            quad(DVec3::new(0.0, 0.0, 1.0), 1.0, 1.0),
+        ]);
+        // leaving the lower polygon upward, skipping it: hits the upper one
+        let h = acc
+            .closest(
+                DVec3::new(0.1, 0.1, 0.0),
+                DVec3::Z,
+                0.0,
+                f64::INFINITY,
+                Some(0),
+            )
+            .unwrap();
+        assert_eq!(h.shape, 1);
+        assert!((h.t - 1.0).abs() < 1e-12);
+        // with a relative tmin instead of skipping, the start surface is not hit either
+        let h = acc
+            .closest(
+                DVec3::new(0.1, 0.1, 0.0),
+                DVec3::Z,
+                1e-9,
+                f64::INFINITY,
+                None,
+            )
+            .unwrap();
+        assert_eq!(h.shape, 1);
+    }
+
+    #[test]
+    fn ray_through_shared_edge_and_vertex_does_not_leak() {
+        // two triangles sharing the diagonal of a unit square, and four squares sharing a vertex
+        let tri =
+            |a: DVec3, b: DVec3, c: DVec3| Shape::Polygon(Polygon::new(vec![a, b, c]).unwrap().0);
+        let shapes = vec![
+            tri(DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0)),
+            tri(DVec3::ZERO, DVec3::new(1.0, 1.0, 0.0), DVec3::Y),
+            quad(DVec3::new(5.5, 5.5, 0.0), 0.5, 0.5),
+            quad(DVec3::new(4.5, 5.5, 0.0), 0.5, 0.5),
+            quad(DVec3::new(5.5, 4.5, 0.0), 0.5, 0.5),
+            quad(DVec3::new(4.5, 4.5, 0.0), 0.5, 0.5),
+        ];
+        let acc = Accel::new(shapes);
+        for k in 0..=20 {
+            let s = k as f64 / 20.0;
+            assert!(
+                acc.closest(DVec3::new(s, s, 1.0), -DVec3::Z, 0.0, 9.0, None)
+                    .is_some(),
+                "diag {s}"
+            );
+        }
+        assert!(acc
+            .closest(DVec3::new(5.0, 5.0, 1.0), -DVec3::Z, 0.0, 9.0, None)
+            .is_some());
+        assert!(acc
+            .closest(DVec3::new(5.0, 4.7, 1.0), -DVec3::Z, 0.0, 9.0, None)
+            .is_some());
+    }
+
+    #[test]
+    fn millimetre_slat_one_km_away() {
+        let mut shapes = vec![quad(DVec3::new(1000.0, 1000.0, 0.0), 0.5, 0.0005)];
+        for i in 0..10 {
+            shapes.push(quad(DVec3::new(i as f64 * 3.0, 0.0, -1.0), 1.0, 1.0));
+        }
+        let acc = Accel::new(shapes);
+        let mut hits = 0;
+        for k in 0..=100 {
+            let y = 1000.0 - 0.0005 + 0.001 * k as f64 / 100.0;
+            let h = acc.closest(
+                DVec3::new(1000.0, y, 1.0),
+                -DVec3::Z,
+                1e-9,
+                f64::INFINITY,
+                None,
+            );
+            if h.is_some_and(|h| h.shape == 0) {
+                hits += 1;
+            }
+        }
+        assert_eq!(hits, 101);
+        let miss = acc.closest(
+            DVec3::new(1000.0, 1000.0011, 1.0),
+            -DVec3::Z,
+            1e-9,
+            f64::INFINITY,
+            None,
+        );
+        assert!(miss.is_none());
+    }
+}

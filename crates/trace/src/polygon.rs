@@ -1,0 +1,270 @@
+//! Planar polygons: convex or concave, intersected in f64 relative to their first vertex.
+//!
+//! The inside test is a crossing-number test in the plane's dominant projection, with
+//! points within a tiny relative distance of an edge counted inside, so a ray through a
+//! shared edge or vertex never leaks between neighbouring polygons.
+
+use glam::{DVec2, DVec3};
+
+use crate::shape::PARALLEL_EPS;
+
+/// A planar polygon.
+#[derive(Debug, Clone)]
+pub struct Polygon {
+    /// Local origin (first vertex).
+    pub origin: DVec3,
+    /// Vertices in world coordinates.
+    pub verts: Vec<DVec3>,
+    /// Unit normal by the right-hand rule.
+    pub normal: DVec3,
+    /// Area.
+    pub area: f64,
+    /// Projection axes (indices of the two coordinates kept).
+    axes: (usize, usize),
+    /// Projected vertices relative to `origin`.
+    pts: Vec<DVec2>,
+    /// Edge tolerance in projected units.
+    tol: f64,
+}
+
+/// Why a polygon cannot be used.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PolygonError {
+    /// Fewer than 3 vertices.
+    TooFewVertices(usize),
+    /// Zero area (collinear or repeated vertices).
+    Degenerate,
+    /// Vertices not in one plane.
+    NonPlanar(f64),
+}
+
+impl std::fmt::Display for PolygonError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            PolygonError::TooFewVertices(n) => {
+                write!(f, "polygon has {n} vertices (needs 3 or more)")
+            }
+            PolygonError::Degenerate => {
+                write!(
+                    f,
+                    "degenerate polygon (zero area: collinear or repeated vertices)"
+                )
+            }
+            PolygonError::NonPlanar(d) => {
+                write!(f, "non-planar polygon (a vertex is {d:.3e} off the plane)")
+            }
+        }
+    }
+}
+
+impl Polygon {
+    /// Builds a polygon; a degenerate one is an error (the caller warns and skips it).
+    /// A slightly non-planar polygon is accepted (as Radiance does) and reported only
+    /// when the deviation exceeds 1e-3 of its size.
+    pub fn new(verts: Vec<DVec3>) -> Result<(Polygon, Option<PolygonError>), PolygonError> {
+        if verts.len() < 3 {
+            return Err(PolygonError::TooFewVertices(verts.len()));
+        }
+        let origin = verts[0];
+        // Newell's method on coordinates relative to the first vertex.
+        let mut nrm = DVec3::ZERO;
+        for i in 0..verts.len() {
+            let a = verts[i] - origin;
+            let b = verts[(i + 1) % verts.len()] - origin;
+            nrm += a.cross(b);
+        }
+        let len = nrm.length();
+        let mut size: f64 = 0.0;
+        for v in &verts {
+            size = size.max((*v - origin).length());
+        }
+        if !(len.is_finite()) || size == 0.0 || len <= 1e-12 * size * size {
+            return Err(PolygonError::Degenerate);
+        }
+        let normal = nrm / len;
+        let area = 0.5 * len;
+        let mut dev: f64 = 0.0;
+        for v in &verts {
+            dev = dev.max((*v - origin).dot(normal).abs());
+        }
+        let warn = (dev > 1e-3 * size).then_some(PolygonError::NonPlanar(dev));
+        let an = normal.abs();
+        let axes = if an.x >= an.y && an.x >= an.z {
+            (1, 2)
+        } else if an.y >= an.z {
+            (2, 0)
+        } else {
+            (0, 1)
+        };
+        let pts = verts
+            .iter()
+            .map(|v| {
+                let d = *v - origin;
+                DVec2::new(d[axes.0], d[axes.1])
+            })
+            .collect();
+        Ok((
+            Polygon {
+                origin,
+                verts,
+                normal,
+                area,
+                axes,
+                pts,
+                tol: 1e-10 * size,
+            },
+            warn,
+        ))
+    }
+
+    /// Nearest intersection in (tmin, tmax).
+    pub fn intersect(&self, org: DVec3, dir: DVec3, tmin: f64, tmax: f64) -> Option<f64> {
+        let dn = dir.dot(self.normal);
+        if dn.abs() < PARALLEL_EPS {
+            return None;
+        }
+        let rel = org - self.origin;
+        let t = -rel.dot(self.normal) / dn;
+        if !(t > tmin && t < tmax) {
+            return None;
+        }
+        let p = rel + dir * t;
+        let q = DVec2::new(p[self.axes.0], p[self.axes.1]);
+        self.contains(q).then_some(t)
+    }
+
+    fn contains(&self, q: DVec2) -> bool {
+        let n = self.pts.len();
+        let mut inside = false;
+        let mut j = n - 1;
+        for i in 0..n {
+            let (a, b) = (self.pts[j], self.pts[i]);
+            if (b.y > q.y) != (a.y > q.y) {
+                let x = a.x + (q.y - a.y) * (b.x - a.x) / (b.y - a.y);
+                if q.x < x {
+                    inside = !inside;
+                }
+            }
+            j = i;
+        }
+        inside || self.on_edge(q)
+    }
+
+    fn on_edge(&self, q: DVec2) -> bool {
+        let n = self.pts.len();
+        (0..n).any(|i| {
+            let (a, b) = (self.pts[i], self.pts[(i + 1) % n]);
+            let ab = b - a;
+            let l2 = ab.length_squared();
+            let s = if l2 > 0.0 {
+                ((q - a).dot(ab) / l2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            (a + ab * s - q).length_squared() <= self.tol * self.tol
+        })
+    }
+
+    /// Exact bounds.
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for v in &self.verts {
+            lo = lo.min(*v);
+            hi = hi.max(*v);
+        }
+        (lo, hi)
+    }
+
+    /// Centroid of the vertices (area-weighted for the fan; used for sources).
+    pub fn centroid(&self) -> DVec3 {
+        let mut acc = DVec3::ZERO;
+        let mut w = 0.0;
+        let o = self.origin;
+        for i in 1..self.verts.len() - 1 {
+            let (a, b) = (self.verts[i] - o, self.verts[i + 1] - o);
+            let ar = a.cross(b).dot(self.normal) * 0.5;
+            acc += (a + b) / 3.0 * ar;
+            w += ar;
+        }
+        if w.abs() > 0.0 {
+            o + acc / w
+        } else {
+            o
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sq(z: f64) -> Polygon {
+        Polygon::new(vec![
+            DVec3::new(0.0, 0.0, z),
+            DVec3::new(1.0, 0.0, z),
+            DVec3::new(1.0, 1.0, z),
+            DVec3::new(0.0, 1.0, z),
+        ])
+        .unwrap()
+        .0
+    }
+
+    #[test]
+    fn square_hit_and_normal() {
+        let p = sq(0.0);
+        assert_eq!(p.normal, DVec3::Z);
+        assert!((p.area - 1.0).abs() < 1e-15);
+        let t = p
+            .intersect(DVec3::new(0.5, 0.5, 2.0), -DVec3::Z, 0.0, f64::INFINITY)
+            .unwrap();
+        assert_eq!(t, 2.0);
+        assert!(p
+            .intersect(DVec3::new(1.5, 0.5, 2.0), -DVec3::Z, 0.0, f64::INFINITY)
+            .is_none());
+    }
+
+    #[test]
+    fn concave_l_shape() {
+        // L: the square (1..2)x(1..2) is missing
+        let p = Polygon::new(vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(2.0, 0.0, 0.0),
+            DVec3::new(2.0, 1.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(1.0, 2.0, 0.0),
+            DVec3::new(0.0, 2.0, 0.0),
+        ])
+        .unwrap()
+        .0;
+        let hit = |x: f64, y: f64| {
+            p.intersect(DVec3::new(x, y, 1.0), -DVec3::Z, 0.0, 9.0)
+                .is_some()
+        };
+        assert!(hit(0.5, 0.5) && hit(1.5, 0.5) && hit(0.5, 1.5));
+        assert!(!hit(1.5, 1.5));
+        assert!((p.area - 3.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn degenerate_polygons_are_rejected() {
+        let col = Polygon::new(vec![DVec3::ZERO, DVec3::X, DVec3::new(2.0, 0.0, 0.0)]);
+        assert_eq!(col.err(), Some(PolygonError::Degenerate));
+        let rep = Polygon::new(vec![DVec3::ZERO, DVec3::ZERO, DVec3::ZERO]);
+        assert_eq!(rep.err(), Some(PolygonError::Degenerate));
+        let two = Polygon::new(vec![DVec3::ZERO, DVec3::X]);
+        assert_eq!(two.err(), Some(PolygonError::TooFewVertices(2)));
+    }
+
+    #[test]
+    fn vertex_and_edge_hits_are_inside() {
+        let p = sq(0.0);
+        for (x, y) in [(0.0, 0.0), (1.0, 1.0), (0.5, 0.0), (1.0, 0.5), (0.0, 1.0)] {
+            assert!(
+                p.intersect(DVec3::new(x, y, 1.0), -DVec3::Z, 0.0, 9.0)
+                    .is_some(),
+                "({x},{y})"
+            );
+        }
+    }
+}
