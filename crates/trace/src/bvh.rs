@@ -37,10 +37,27 @@ pub struct Accel {
     pub scale: f64,
 }
 
+/// The next f32 towards +inf (f32::next_up needs Rust 1.86; MSRV is 1.85).
+fn f32_next_up(f: f32) -> f32 {
+    if f.is_nan() || f == f32::INFINITY {
+        return f;
+    }
+    if f == 0.0 {
+        return f32::from_bits(1);
+    }
+    let b = f.to_bits();
+    f32::from_bits(if f > 0.0 { b + 1 } else { b - 1 })
+}
+
+/// The next f32 towards -inf.
+fn f32_next_down(f: f32) -> f32 {
+    -f32_next_up(-f)
+}
+
 fn down(x: f64) -> f32 {
     let f = x as f32;
     if (f as f64) > x {
-        f.next_down()
+        f32_next_down(f)
     } else {
         f
     }
@@ -49,7 +66,7 @@ fn down(x: f64) -> f32 {
 fn up(x: f64) -> f32 {
     let f = x as f32;
     if (f as f64) < x {
-        f.next_up()
+        f32_next_up(f)
     } else {
         f
     }
