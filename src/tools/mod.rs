@@ -4,11 +4,12 @@
 use std::process::ExitCode;
 
 pub mod gendaymtx;
+pub mod gensky;
 
 /// A tool's entry point.
 pub type Run = fn(Vec<String>) -> anyhow::Result<ExitCode>;
 
 /// Every tool by name (for the multicall `fenestra TOOL …` binary).
 pub fn registry() -> &'static [(&'static str, Run)] {
-    &[("gendaymtx", gendaymtx::run)]
+    &[("gendaymtx", gendaymtx::run), ("gensky", gensky::run)]
 }

@@ -176,7 +176,7 @@ pub fn compute(inp: &CieInputs, altitude: f64, azimuth: f64) -> CieSky {
     };
     if !cloudy && sun_dir[2] > 0.0 && solar_ok {
         let lsun = match inp.solar {
-            Given::Irradiance(e) => e / (6e-5 * sun_dir[2]),
+            Given::Irradiance(e) => e / (5.98e-5 * sun_dir[2]),
             Given::Radiance(l) => l,
             Given::Default => {
                 let s = 1.5e9 / SUN_EFFICACY

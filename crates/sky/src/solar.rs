@@ -32,12 +32,12 @@ pub struct Site {
 }
 
 impl Default for Site {
-    /// Radiance's built-in site (San Francisco area, PST).
+    /// gensky's built-in site (0.66 rad N, 2.13 rad W, meridian 120° W).
     fn default() -> Self {
         Site {
             latitude: 0.66,
             longitude: 2.13,
-            meridian: 2.0944,
+            meridian: 120.0 * (PI / 180.0),
         }
     }
 }
@@ -92,8 +92,17 @@ impl Site {
         }
     }
 
-    /// Michalsky (1988) solar position for a calendar date and local standard time.
-    pub fn position_michalsky(&self, year: i32, month: i32, day: i32, hour: f64) -> SunPosition {
+    /// Michalsky (1988) solar position for a calendar date and local time
+    /// (`solar_time`: the hour is solar time and only the declination comes from
+    /// the Michalsky model, evaluated as if the hour were standard time).
+    pub fn position_michalsky(
+        &self,
+        year: i32,
+        month: i32,
+        day: i32,
+        hour: f64,
+        solar_time: bool,
+    ) -> SunPosition {
         let deg = PI / 180.0;
         // Days since J2000.0 (2000-01-01 12:00 UT) for the UT instant.
         let ut = hour + self.meridian * (12.0 / PI);
@@ -107,7 +116,11 @@ impl Site {
         let sd = (obliq.sin() * ecl.sin()).asin();
         let gmst = (6.697375 + 0.0657098242 * n + ut).rem_euclid(24.0);
         let lmst = (gmst - self.longitude * (12.0 / PI)).rem_euclid(24.0);
-        let st = (lmst - ra * (12.0 / PI) + 12.0).rem_euclid(24.0);
+        let st = if solar_time {
+            hour
+        } else {
+            (lmst - ra * (12.0 / PI) + 12.0).rem_euclid(24.0)
+        };
         SunPosition {
             altitude: self.altitude(sd, st),
             azimuth: self.azimuth(sd, st),
