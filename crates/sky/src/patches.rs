@@ -134,6 +134,9 @@ impl Reinhart {
     /// the arithmetic of reinhart.cal's `rbin`: 0 below the horizon (the exact
     /// horizon is sky row 0), azimuth from north toward east, and its quirk that an
     /// azimuth within 1e-4° below 360° minus half a patch wraps to the row's first patch.
+    /// Divisions by the constants DEGREE and alpha are multiplications by their
+    /// reciprocals, as the .cal compiler folds them (this decides directions lying
+    /// exactly on a row boundary).
     pub fn patch_of(&self, d: [f64; 3]) -> usize {
         let degree = PI / 180.0;
         let asin = if d[2] - 1.0 > 0.0 {
@@ -143,7 +146,7 @@ impl Reinhart {
         } else {
             d[2].asin()
         };
-        let alt = asin / degree;
+        let alt = asin * (1.0 / degree);
         if -alt > 0.0 {
             return 0;
         }
@@ -151,9 +154,9 @@ impl Reinhart {
         if -azi > 0.0 {
             azi += 2.0 * PI;
         }
-        let azi = azi / degree;
+        let azi = azi * (1.0 / degree);
         let alpha = 90.0 / (self.mf as f64 * 7.0 + 0.5);
-        let r = ((alt / alpha).floor() as usize).min(self.rows() - 1);
+        let r = ((alt * (1.0 / alpha)).floor() as usize).min(self.rows() - 1);
         let inc = 360.0 / self.row_len[r] as f64;
         let c = if 359.9999 - 0.5 * inc - azi > 0.0 {
             ((azi + 0.5 * inc) / inc).floor() as usize
