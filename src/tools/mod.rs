@@ -5,11 +5,16 @@ use std::process::ExitCode;
 
 pub mod gendaymtx;
 pub mod gensky;
+pub mod genskyvec;
 
 /// A tool's entry point.
 pub type Run = fn(Vec<String>) -> anyhow::Result<ExitCode>;
 
 /// Every tool by name (for the multicall `fenestra TOOL …` binary).
 pub fn registry() -> &'static [(&'static str, Run)] {
-    &[("gendaymtx", gendaymtx::run), ("gensky", gensky::run)]
+    &[
+        ("gendaymtx", gendaymtx::run),
+        ("gensky", gensky::run),
+        ("genskyvec", genskyvec::run),
+    ]
 }

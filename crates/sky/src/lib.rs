@@ -5,5 +5,6 @@ pub mod cie;
 pub mod daymtx;
 pub mod patches;
 pub mod perez;
+pub mod skyvec;
 pub mod solar;
 pub mod weather;

@@ -1,0 +1,226 @@
+//! genskyvec: Reinhart sky vector of a gensky/gendaylit sky description.
+
+use anyhow::{anyhow, bail, Context, Result};
+use fenestra_sky::cie::SkyBright;
+use fenestra_sky::daymtx::fmt_g;
+use fenestra_sky::patches::Reinhart;
+use fenestra_sky::skyvec::{self, PerezLum, Row, SkyVecOptions, Sun};
+use std::io::{Read, Write};
+use std::process::ExitCode;
+
+/// One primitive of the description, words kept as written.
+struct Prim {
+    modifier: String,
+    ptype: String,
+    name: String,
+    sargs: Vec<String>,
+    rargs: Vec<String>,
+}
+
+/// Splits scene text into primitives (comments and `!command` lines skipped).
+fn primitives(text: &str) -> Result<Vec<Prim>> {
+    let mut words: Vec<(&str, usize)> = Vec::new();
+    for (ln, line) in text.lines().enumerate() {
+        let t = line.trim_start();
+        if t.starts_with('!') {
+            bail!(
+                "line {}: commands in sky descriptions are not supported by fenestra genskyvec",
+                ln + 1
+            );
+        }
+        for w in line.split_whitespace() {
+            if w.starts_with('#') {
+                break;
+            }
+            words.push((w, ln + 1));
+        }
+    }
+    let mut prims = Vec::new();
+    let mut i = 0;
+    let count = |i: usize, what: &str| -> Result<usize> {
+        let (w, ln) = words
+            .get(i)
+            .ok_or_else(|| anyhow!("unexpected end of sky description: expected {what}"))?;
+        w.parse::<usize>()
+            .map_err(|_| anyhow!("line {ln}: expected {what}, found '{w}'"))
+    };
+    while i < words.len() {
+        if i + 3 > words.len() {
+            bail!("line {}: incomplete primitive", words[i].1);
+        }
+        let (modifier, ptype, name) = (words[i].0, words[i + 1].0, words[i + 2].0);
+        i += 3;
+        let ns = count(i, "the number of string arguments")?;
+        let sargs = words
+            .get(i + 1..i + 1 + ns)
+            .ok_or_else(|| anyhow!("{name}: missing string arguments"))?
+            .iter()
+            .map(|w| w.0.to_string())
+            .collect();
+        i += 1 + ns;
+        let ni = count(i, "the number of integer arguments")?;
+        i += 1 + ni;
+        let nr = count(i, "the number of real arguments")?;
+        let rargs = words
+            .get(i + 1..i + 1 + nr)
+            .ok_or_else(|| anyhow!("{name}: missing real arguments"))?
+            .iter()
+            .map(|w| w.0.to_string())
+            .collect();
+        i += 1 + nr;
+        prims.push(Prim {
+            modifier: modifier.into(),
+            ptype: ptype.into(),
+            name: name.into(),
+            sargs,
+            rargs,
+        });
+    }
+    Ok(prims)
+}
+
+fn real(w: &str) -> Result<f64> {
+    fenestra_cli::opts::parse_real(w).ok_or_else(|| anyhow!("'{w}' is not a number"))
+}
+
+/// The sky function of a description as a Rust model.
+fn sky_function(p: &Prim) -> Result<Box<dyn Fn([f64; 3]) -> f64 + Sync>> {
+    let a: Vec<f64> = p.rargs.iter().map(|w| real(w)).collect::<Result<_>>()?;
+    if p.ptype != "brightfunc" {
+        bail!(
+            "skyfunc is a '{}'; fenestra genskyvec evaluates brightfunc skies only",
+            p.ptype
+        );
+    }
+    let file = p
+        .sargs
+        .get(1)
+        .map(|s| s.rsplit('/').next().unwrap_or(s).to_string())
+        .unwrap_or_default();
+    let func = p.sargs.first().cloned().unwrap_or_default();
+    if p.sargs.len() != 2 {
+        bail!(
+            "skyfunc: transforms after the function file are not supported by fenestra genskyvec"
+        );
+    }
+    match (func.as_str(), file.as_str()) {
+        ("skybr", "skybright.cal") => {
+            let m = SkyBright::from_args(&a)
+                .ok_or_else(|| anyhow!("skyfunc: bad skybright.cal arguments {:?}", p.rargs))?;
+            Ok(Box::new(move |d| m.radiance(d)))
+        }
+        ("skybright", "perezlum.cal") => {
+            let m = PerezLum::from_args(&a)
+                .ok_or_else(|| anyhow!("skyfunc: perezlum.cal needs 10 real arguments"))?;
+            Ok(Box::new(move |d| m.radiance(d)))
+        }
+        _ => bail!(
+            "skyfunc: function '{func}' of '{file}' is not supported by fenestra genskyvec (skybr of skybright.cal and skybright of perezlum.cal are)"
+        ),
+    }
+}
+
+/// Runs genskyvec.
+pub fn run(args: Vec<String>) -> Result<ExitCode> {
+    let mut opt = SkyVecOptions::default();
+    let mut header = true;
+    let mut i = 1;
+    while i < args.len() {
+        match args[i].as_str() {
+            "-c" => {
+                for k in 0..3 {
+                    let w = args
+                        .get(i + 1 + k)
+                        .ok_or_else(|| anyhow!("-c needs r g b"))?;
+                    opt.color[k] = real(w)?;
+                }
+                i += 3;
+            }
+            "-m" => {
+                let w = args
+                    .get(i + 1)
+                    .ok_or_else(|| anyhow!("-m needs a number"))?;
+                let mf = fenestra_cli::opts::parse_int(w)
+                    .filter(|&v| v >= 1)
+                    .ok_or_else(|| anyhow!("-m needs a positive integer, got '{w}'"))?;
+                opt.mf = mf as usize;
+                i += 1;
+            }
+            "-d" => opt.sky = false,
+            "-h" => header = false,
+            "-5" => opt.five_phase = true,
+            "--help" => {
+                println!("Usage: genskyvec [-h][-m N][-c r g b][-d][-5] < sky.rad\nReinhart sky vector (ground first) of a sky description on standard input.");
+                return Ok(ExitCode::SUCCESS);
+            }
+            w => bail!("Unexpected command-line argument: {w}"),
+        }
+        i += 1;
+    }
+    let mut text = String::new();
+    std::io::stdin()
+        .read_to_string(&mut text)
+        .context("reading the sky description")?;
+    let prims = primitives(&text)?;
+    let Some(skyfunc) = prims.iter().rev().find(|p| p.name == "skyfunc") else {
+        bail!("Bad sky description!");
+    };
+    let f = sky_function(skyfunc)?;
+    // the sun: a 'source' whose modifier is a 'light'
+    let mut sun = None;
+    for p in &prims {
+        if p.ptype != "source" {
+            continue;
+        }
+        let Some(l) = prims
+            .iter()
+            .rev()
+            .find(|q| q.name == p.modifier && q.ptype == "light")
+        else {
+            continue;
+        };
+        if l.rargs.len() < 3 || p.rargs.len() < 4 {
+            bail!(
+                "sun '{}': light needs 3 and source 4 real arguments",
+                p.name
+            );
+        }
+        let w = [l.rargs[0].clone(), l.rargs[1].clone(), l.rargs[2].clone()];
+        sun = Some(Sun {
+            radiance: [real(&w[0])?, real(&w[1])?, real(&w[2])?],
+            radiance_words: w,
+            dir: [real(&p.rargs[0])?, real(&p.rargs[1])?, real(&p.rargs[2])?],
+            diameter: real(&p.rargs[3])?,
+        });
+    }
+    let rows = skyvec::sky_vector(&opt, &*f, sun.as_ref());
+    let mut out = String::new();
+    if header {
+        out.push_str("#?RADIANCE\n");
+        out.push_str(&fenestra_cli::command_line(&args));
+        out.push('\n');
+        out.push_str(&format!(
+            "NROWS={}\nNCOLS=1\nNCOMP=3\nFORMAT=ascii\n\n",
+            Reinhart::new(opt.mf).len()
+        ));
+    }
+    for r in &rows {
+        match r {
+            Row::Mean(v) => out.push_str(&format!(
+                "{}\t{}\t{}\n",
+                fmt_g(v[0], 9),
+                fmt_g(v[1], 9),
+                fmt_g(v[2], 9)
+            )),
+            Row::WithSun(v) => out.push_str(&format!(
+                "{}\t{}\t{}\n",
+                fmt_g(v[0], 15),
+                fmt_g(v[1], 15),
+                fmt_g(v[2], 15)
+            )),
+            Row::Words(w) => out.push_str(&format!("{}\t{}\t{}\n", w[0], w[1], w[2])),
+        }
+    }
+    std::io::stdout().lock().write_all(out.as_bytes())?;
+    Ok(ExitCode::SUCCESS)
+}
