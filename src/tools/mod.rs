@@ -3,6 +3,7 @@
 
 use std::process::ExitCode;
 
+pub mod gendaylit;
 pub mod gendaymtx;
 pub mod gensky;
 pub mod genskyvec;

@@ -2,6 +2,7 @@
 //! (gendaymtx, gendaylit), the Reinhart patch basis and sky vectors (genskyvec).
 
 pub mod cie;
+pub mod daylit;
 pub mod daymtx;
 pub mod patches;
 pub mod perez;
