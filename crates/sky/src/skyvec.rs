@@ -186,6 +186,15 @@ pub fn sky_vector(
     rows
 }
 
+/// The .cal library's `Exp`: 0 below −100, else `exp`.
+pub fn cal_exp(x: f64) -> f64 {
+    if -x - 100.0 > 0.0 {
+        0.0
+    } else {
+        x.exp()
+    }
+}
+
 /// The Perez all-weather sky as `perezlum.cal` describes it (gendaylit output):
 /// arguments diffuse normalisation, ground brightness, a..e, sun direction.
 #[derive(Debug, Clone, Copy, PartialEq)]
