@@ -17,7 +17,7 @@ fn directions() -> Vec<[f64; 3]> {
     for i in 0..40 {
         let z = -1.0 + 2.0 * (i as f64 + 0.5) / 40.0;
         for j in 0..12 {
-            let phi = j as f64 * 0.5236 + i as f64 * 0.1;
+            let phi = j as f64 * std::f64::consts::FRAC_PI_6 + i as f64 * 0.1;
             let r = (1.0 - z * z).sqrt();
             v.push([r * phi.cos(), r * phi.sin(), z]);
         }
