@@ -175,3 +175,45 @@ fn bad_descriptions_fail() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("Bad sky description"));
 }
+
+/// The sun's energy is conserved when it is spread over patches:
+/// Σ row × Ω_row over the sun-only vector = Ω_sun × L_sun (Ω_sun = π³(d/360)²,
+/// genskyvec's own π), whatever the sun position: on a row and column boundary,
+/// clamped near the zenith, low over the horizon. Tolerance 1e-7 relative: the
+/// angles and solid angles pass through 9 printed digits as in Radiance.
+#[test]
+fn sun_energy_is_conserved() {
+    for ang in [
+        ["12", "6"],
+        ["90", "0"],
+        ["36", "-90"],
+        ["1", "179"],
+        ["60.5", "33.3"],
+    ] {
+        let sky = common::run_ok(
+            common::fenestra("gensky").args(["-ang", ang[0], ang[1], "+s", "-r", "1e6"]),
+        );
+        for mf in [1usize, 2, 4] {
+            let v = rows(&genskyvec(&["-m", &mf.to_string(), "-d", "-h"], &sky));
+            let b = fenestra_sky::patches::Reinhart::new(mf);
+            let total: f64 = v
+                .iter()
+                .enumerate()
+                .skip(1)
+                .map(|(p, r)| r[0] * fenestra_sky::skyvec::bin_omega(&b, p))
+                .sum();
+            #[allow(clippy::approx_constant)]
+            let pi9 = 3.141592654f64;
+            let want = 1e6 * pi9.powi(3) * (0.5f64 / 360.0).powi(2);
+            assert!(
+                (total - want).abs() <= 1e-7 * want,
+                "sun at {ang:?}, MF {mf}: {total} vs {want}"
+            );
+            assert_eq!(
+                v.iter().filter(|r| r[0] != 0.0).count(),
+                3,
+                "{ang:?} MF {mf}"
+            );
+        }
+    }
+}

@@ -116,6 +116,11 @@ pub fn bin_omega(basis: &Reinhart, b: usize) -> f64 {
     width * ((rah * (r as f64 + 1.0)).sin() - (rah * r as f64).sin())
 }
 
+/// A value as rcalc prints it (`%.9g`) and reads back.
+fn printed9(v: f64) -> f64 {
+    format!("{v:.8e}").parse().unwrap_or(v)
+}
+
 /// Computes the sky vector: `radiance(dir)` is the sky function (skyfunc) for a
 /// unit direction.
 pub fn sky_vector(
@@ -159,7 +164,9 @@ pub fn sky_vector(
         let dot = d[0] * sun.dir[0] + d[1] * sun.dir[1] + d[2] * sun.dir[2];
         if dot - 0.866 > 0.0 {
             let ang = if 1.0 - dot > 0.0 { dot.acos() } else { 0.0 };
-            cand.push((ang, bin_omega(&basis, b), b));
+            // genskyvec reads these back from rcalc's text output (9 digits), so
+            // near-equal angles tie and keep patch order, as in Radiance
+            cand.push((printed9(ang), printed9(bin_omega(&basis, b)), b));
         }
     }
     cand.sort_by(|a, b| a.0.total_cmp(&b.0));
