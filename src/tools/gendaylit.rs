@@ -67,11 +67,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             return Err(usage("bad day"));
         }
         let w = &args[3];
-        hour = if let Some((h, m)) = w.split_once(':') {
-            atof(h) + atof(m) / 60.0
-        } else {
-            atof(w)
-        };
+        // Radiance's gendaylit reads the hour with atof: "14:30" is 14.
+        hour = atof(w);
         if !(0.0..24.0).contains(&hour) {
             return Err(usage("bad hour"));
         }
@@ -82,6 +79,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let mut output = DaylitOutput::Visible;
     let mut with_sun = true;
     let mut refl = 0.2;
+    let mut year: Option<i32> = None;
     let mut i = 4;
     while i < args.len() {
         let a = args[i].as_bytes();
@@ -107,7 +105,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 site.meridian = val(&args, i)? * (PI / 180.0);
             }
             b'y' => {
-                anyhow::bail!("option -y is not supported by fenestra gendaylit (its Michalsky time handling differs from Radiance's)");
+                i += 1;
+                year = Some(val(&args, i)? as i32);
             }
             b'O' => {
                 i += 1;
@@ -149,15 +148,19 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         out.push_str(if k == 0 { fenestra_cli::prog() } else { a });
     }
     out.push('\n');
-    let (mut alt, azi, daynumber) = if month != 0 {
-        let p = site.position(month, day, hour, solar_time);
+    let (mut alt, azi, daynumber, solar_hours) = if month != 0 {
+        let p = match year {
+            Some(y) => site.position_michalsky(y, month, day, hour, solar_time),
+            None => site.position(month, day, hour, solar_time),
+        };
         (
             p.altitude,
             p.azimuth,
             f64::from(solar::julian_day(month, day)),
+            p.solar_time,
         )
     } else {
-        (angles.0, angles.1, 0.0)
+        (angles.0, angles.1, 0.0, 0.0)
     };
     if alt > 87.0 * PI / 180.0 {
         eprintln!(
@@ -197,14 +200,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         input = Some(DaylitInput::HorizontalIrradiance(dirh, dif));
     }
     {
-        let st = if month == 0 {
-            0.0
-        } else if solar_time {
-            hour
-        } else {
-            let p = site.position(month, day, hour, false);
-            p.solar_time
-        };
+        let st = solar_hours;
         out.push_str(&format!("# Local solar time: {st:.2}\n"));
         out.push_str(&format!(
             "# Solar altitude and azimuth: {:.1} {:.1}\n",
