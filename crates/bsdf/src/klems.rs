@@ -1,0 +1,453 @@
+//! Klems angle bases (LBNL/Klems Full, Half, Quarter, and bases defined in a BSDF XML file).
+//!
+//! # Conventions (the same as Radiance's)
+//! * A basis is a list of rings around the surface normal, numbered from the normal outwards;
+//!   patches are numbered ring by ring from 0 (the normal cap), and inside a ring by increasing
+//!   azimuth. Patch `j` of a ring with `n` patches is centred on azimuth `360·j/n` degrees, so
+//!   patch 0 of every ring straddles azimuth 0.
+//! * Directions are expressed in a local frame: `z` = surface normal, `y` = up vector (made
+//!   perpendicular to the normal), `x = y × z` ("right" seen from the `+z` side; a left-handed
+//!   frame negates `x`). Azimuth runs from `+x` towards `+y`.
+//! * Angles at the boundaries follow Radiance's `klems_full.cal` shipped with Radiance 6.0a
+//!   (the binning `rcontrib` applies): a polar angle exactly on a ring boundary belongs to the
+//!   **inner** ring, a direction at exactly 90° belongs to the outer ring, and a direction with
+//!   a negative `z` is in the wrong hemisphere (`None`).
+//! * [`Frame`] turns a world ray direction into the local direction the `.cal` functions bin:
+//!   the *reversed* ray direction (the propagation direction of light arriving along the ray).
+
+use std::f64::consts::PI;
+use std::sync::OnceLock;
+
+/// One ring of a Klems basis: polar bounds in degrees and the number of azimuthal patches.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Ring {
+    /// Lower polar bound (degrees).
+    pub theta_lo: f64,
+    /// Upper polar bound (degrees).
+    pub theta_hi: f64,
+    /// Number of azimuthal patches in the ring.
+    pub nphi: usize,
+    /// Index of the ring's first patch.
+    pub first: usize,
+}
+
+/// A Klems angle basis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct KlemsBasis {
+    name: String,
+    rings: Vec<Ring>,
+    len: usize,
+}
+
+/// Error building a basis from ring bounds.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum BasisError {
+    /// The ring list is empty.
+    #[error("angle basis has no rings")]
+    Empty,
+    /// A ring's bounds are not increasing or do not start at 0 / end at 90 degrees.
+    #[error("angle basis ring {ring}: {what}")]
+    BadRing {
+        /// 0-based ring index.
+        ring: usize,
+        /// What is wrong.
+        what: String,
+    },
+}
+
+/// Name of the full basis as written in BSDF XML files.
+pub const FULL_NAME: &str = "LBNL/Klems Full";
+/// Name of the half basis.
+pub const HALF_NAME: &str = "LBNL/Klems Half";
+/// Name of the quarter basis.
+pub const QUARTER_NAME: &str = "LBNL/Klems Quarter";
+
+impl KlemsBasis {
+    /// Builds a basis from `(upper polar bound in degrees, patches)` per ring, inner to outer;
+    /// the first ring starts at 0 and the last must end at 90.
+    pub fn from_bounds(name: &str, rings: &[(f64, usize)]) -> Result<Self, BasisError> {
+        if rings.is_empty() {
+            return Err(BasisError::Empty);
+        }
+        let mut out = Vec::with_capacity(rings.len());
+        let mut lo = 0.0;
+        let mut first = 0;
+        for (i, &(hi, n)) in rings.iter().enumerate() {
+            let bad = |what: &str| BasisError::BadRing { ring: i, what: what.to_string() };
+            if !hi.is_finite() || hi <= lo || hi > 90.0 {
+                return Err(bad(&format!("upper bound {hi} must lie in ({lo}, 90]")));
+            }
+            if n == 0 {
+                return Err(bad("needs at least one patch"));
+            }
+            if n == 1 && i != 0 {
+                return Err(bad("a single-patch ring is only allowed around the normal"));
+            }
+            out.push(Ring { theta_lo: lo, theta_hi: hi, nphi: n, first });
+            first += n;
+            lo = hi;
+        }
+        if lo != 90.0 {
+            return Err(BasisError::BadRing {
+                ring: rings.len() - 1,
+                what: format!("last ring must end at 90 degrees, not {lo}"),
+            });
+        }
+        Ok(KlemsBasis { name: name.to_string(), rings: out, len: first })
+    }
+
+    /// LBNL/Klems Full: 145 patches.
+    pub fn full() -> &'static KlemsBasis {
+        static B: OnceLock<KlemsBasis> = OnceLock::new();
+        B.get_or_init(|| {
+            let bounds = [5., 15., 25., 35., 45., 55., 65., 75., 90.];
+            let n = [1, 8, 16, 20, 24, 24, 24, 16, 12];
+            Self::builtin(FULL_NAME, &bounds, &n)
+        })
+    }
+
+    /// LBNL/Klems Half: 77 patches (the current definition used by WINDOW and Radiance 6).
+    pub fn half() -> &'static KlemsBasis {
+        static B: OnceLock<KlemsBasis> = OnceLock::new();
+        B.get_or_init(|| {
+            let bounds = [6.5, 19.5, 32.5, 45.5, 58.5, 71.5, 90.];
+            let n = [1, 8, 12, 16, 20, 12, 8];
+            Self::builtin(HALF_NAME, &bounds, &n)
+        })
+    }
+
+    /// LBNL/Klems Quarter: 41 patches.
+    pub fn quarter() -> &'static KlemsBasis {
+        static B: OnceLock<KlemsBasis> = OnceLock::new();
+        B.get_or_init(|| {
+            let bounds = [9., 27., 45., 63., 90.];
+            let n = [1, 8, 12, 12, 8];
+            Self::builtin(QUARTER_NAME, &bounds, &n)
+        })
+    }
+
+    fn builtin(name: &str, bounds: &[f64], n: &[usize]) -> KlemsBasis {
+        let rings: Vec<(f64, usize)> = bounds.iter().copied().zip(n.iter().copied()).collect();
+        Self::from_bounds(name, &rings).expect("built-in basis is valid")
+    }
+
+    /// The built-in basis with this name (case-insensitive), as Radiance recognises them.
+    pub fn by_name(name: &str) -> Option<&'static KlemsBasis> {
+        let n = name.trim();
+        [Self::full(), Self::half(), Self::quarter()]
+            .into_iter()
+            .find(|b| b.name.eq_ignore_ascii_case(n))
+    }
+
+    /// The basis name (e.g. `LBNL/Klems Full`).
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The rings, inner to outer.
+    pub fn rings(&self) -> &[Ring] {
+        &self.rings
+    }
+
+    /// Number of patches.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// True if the basis has no patch (never for a valid basis).
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Ring index and position in the ring of a patch (`None` if out of range).
+    pub fn ring_of(&self, patch: usize) -> Option<(usize, usize)> {
+        if patch >= self.len {
+            return None;
+        }
+        let r = self.rings.partition_point(|ring| ring.first <= patch) - 1;
+        Some((r, patch - self.rings[r].first))
+    }
+
+    /// The patch holding a direction given by polar angle and azimuth in degrees
+    /// (azimuth any real value; polar in [0, 90], else `None`). Boundary rules: see the module.
+    pub fn patch_at(&self, theta_deg: f64, phi_deg: f64) -> Option<usize> {
+        if !(0.0..=90.0).contains(&theta_deg) || !phi_deg.is_finite() {
+            return None;
+        }
+        let last = self.rings.len() - 1;
+        let r = self.rings[..last].iter().position(|ring| theta_deg <= ring.theta_hi).unwrap_or(last);
+        let ring = &self.rings[r];
+        let mut azi = phi_deg % 360.0;
+        if azi < 0.0 {
+            azi += 360.0;
+        }
+        let inc = 360.0 / ring.nphi as f64;
+        let j = if (360.0 - 0.5 * inc) - azi > 0.0 { ((azi + 0.5 * inc) / inc).floor() as usize } else { 0 };
+        Some(ring.first + j.min(ring.nphi - 1))
+    }
+
+    /// The patch holding a local direction (any length; `z` along the normal), or `None` for a
+    /// direction with negative `z` (wrong hemisphere), zero length or non-finite components.
+    pub fn patch(&self, v: [f64; 3]) -> Option<usize> {
+        let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        if !(len > 0.0 && len.is_finite()) {
+            return None;
+        }
+        let (theta, phi) = local_angles([v[0] / len, v[1] / len, v[2] / len]);
+        if theta > 90.0 {
+            return None;
+        }
+        self.patch_at(theta, phi)
+    }
+
+    /// Polar bounds (degrees) and azimuth range (degrees, centre ± half width) of a patch.
+    pub fn bounds(&self, patch: usize) -> Option<PatchBounds> {
+        let (r, j) = self.ring_of(patch)?;
+        let ring = &self.rings[r];
+        let inc = 360.0 / ring.nphi as f64;
+        Some(PatchBounds {
+            theta_lo: ring.theta_lo,
+            theta_hi: ring.theta_hi,
+            phi_lo: inc * (j as f64 - 0.5),
+            phi_hi: inc * (j as f64 + 0.5),
+        })
+    }
+
+    /// Centre direction of a patch (unit vector in the local frame): the normal for the cap,
+    /// else the ring's mid polar angle (the `Theta` a BSDF XML file lists) at azimuth `360·j/n`.
+    pub fn centre(&self, patch: usize) -> Option<[f64; 3]> {
+        let (r, j) = self.ring_of(patch)?;
+        let ring = &self.rings[r];
+        let theta = if r == 0 { 0.0 } else { 0.5 * (ring.theta_lo + ring.theta_hi) };
+        let phi = 360.0 * j as f64 / ring.nphi as f64;
+        Some(direction(theta.to_radians().cos(), phi.to_radians()))
+    }
+
+    /// A direction in a patch from two numbers in [0,1): uniform in projected solid angle
+    /// (cos²θ uniform, as Radiance's BSDF library samples Klems patches).
+    pub fn sample_projected(&self, patch: usize, u0: f64, u1: f64) -> Option<[f64; 3]> {
+        let b = self.bounds(patch)?;
+        let (c_lo, c_hi) = (b.theta_lo.to_radians().cos(), b.theta_hi.to_radians().cos());
+        let cos2 = (1.0 - u0) * c_lo * c_lo + u0 * c_hi * c_hi;
+        let phi = (b.phi_lo + u1 * (b.phi_hi - b.phi_lo)).to_radians();
+        Some(direction(cos2.max(0.0).sqrt(), phi))
+    }
+
+    /// A direction in a patch from two numbers in [0,1): uniform in solid angle (cosθ uniform).
+    pub fn sample_uniform(&self, patch: usize, u0: f64, u1: f64) -> Option<[f64; 3]> {
+        let b = self.bounds(patch)?;
+        let (c_lo, c_hi) = (b.theta_lo.to_radians().cos(), b.theta_hi.to_radians().cos());
+        let c = c_lo + u0 * (c_hi - c_lo);
+        let phi = (b.phi_lo + u1 * (b.phi_hi - b.phi_lo)).to_radians();
+        Some(direction(c.clamp(0.0, 1.0), phi))
+    }
+
+    /// Solid angle of a patch (sr): `2π (cos θlo − cos θhi) / n`.
+    pub fn solid_angle(&self, patch: usize) -> Option<f64> {
+        let (r, _) = self.ring_of(patch)?;
+        let ring = &self.rings[r];
+        let (c_lo, c_hi) = (ring.theta_lo.to_radians().cos(), ring.theta_hi.to_radians().cos());
+        Some(2.0 * PI * (c_lo - c_hi) / ring.nphi as f64)
+    }
+
+    /// Projected solid angle ("lambda") of a patch (sr): `π (cos²θlo − cos²θhi) / n`.
+    pub fn projected_solid_angle(&self, patch: usize) -> Option<f64> {
+        let (r, _) = self.ring_of(patch)?;
+        let ring = &self.rings[r];
+        let (c_lo, c_hi) = (ring.theta_lo.to_radians().cos(), ring.theta_hi.to_radians().cos());
+        Some(PI * (c_lo * c_lo - c_hi * c_hi) / ring.nphi as f64)
+    }
+
+    /// Projected solid angles of all patches, in patch order.
+    pub fn lambdas(&self) -> Vec<f64> {
+        (0..self.len).map(|p| self.projected_solid_angle(p).unwrap_or(0.0)).collect()
+    }
+
+    /// The patch of the same ring rotated by 180° in azimuth.
+    pub fn rotate180(&self, patch: usize) -> Option<usize> {
+        let (r, j) = self.ring_of(patch)?;
+        let ring = &self.rings[r];
+        let c = self.centre(patch)?;
+        if ring.nphi % 2 == 0 {
+            return Some(ring.first + (j + ring.nphi / 2) % ring.nphi);
+        }
+        self.patch([-c[0], -c[1], c[2]])
+    }
+}
+
+/// Polar and azimuthal extent of one patch (degrees).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PatchBounds {
+    /// Lower polar bound.
+    pub theta_lo: f64,
+    /// Upper polar bound.
+    pub theta_hi: f64,
+    /// Lower azimuth (may be negative for patch 0 of a ring).
+    pub phi_lo: f64,
+    /// Upper azimuth.
+    pub phi_hi: f64,
+}
+
+fn direction(cos_theta: f64, phi: f64) -> [f64; 3] {
+    let s = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    [s * phi.cos(), s * phi.sin(), cos_theta]
+}
+
+/// Polar angle (degrees, from +z, clamped to [0,180]) and azimuth (degrees in [0,360), from +x
+/// towards +y) of a unit local direction, computed as Radiance's `klems_full.cal` does.
+pub fn local_angles(v: [f64; 3]) -> (f64, f64) {
+    const DEGREE: f64 = PI / 180.0;
+    let theta = if v[2] > 1.0 {
+        0.0
+    } else if v[2] < -1.0 {
+        PI / DEGREE
+    } else {
+        v[2].acos() / DEGREE
+    };
+    let mut a = v[1].atan2(v[0]);
+    if a < 0.0 {
+        a += 2.0 * PI;
+    }
+    (theta, a / DEGREE)
+}
+
+/// A surface frame: normal `n` (local +z) and up vector `u` (local +y after removing its
+/// normal component), right-handed (`x = u × n`) unless made left-handed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frame {
+    n: [f64; 3],
+    u: [f64; 3],
+    rhs: f64,
+}
+
+impl Frame {
+    /// A right-handed frame; `n` should be unit length, `u` need not be (nor be perpendicular).
+    pub fn new(n: [f64; 3], u: [f64; 3]) -> Self {
+        Frame { n, u, rhs: 1.0 }
+    }
+
+    /// The same frame with `x` negated (Radiance's `RHS=-1`, rfluxmtx `h=-kf`).
+    pub fn left_handed(mut self) -> Self {
+        self.rhs = -self.rhs;
+        self
+    }
+
+    /// Local coordinates `(x, y, z)` of the **reversed** ray direction `-d` (unnormalised in x and
+    /// y; z = cosθ for unit `d`), as `klems_full.cal`'s `kbin(N, U)` computes them.
+    pub fn reversed_local(&self, d: [f64; 3]) -> [f64; 3] {
+        let (n, u) = (self.n, self.u);
+        let dn = d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
+        let du = d[0] * u[0] + d[1] * u[1] + d[2] * u[2];
+        let nu = n[0] * u[0] + n[1] * u[1] + n[2] * u[2];
+        let uxn = [u[1] * n[2] - u[2] * n[1], u[2] * n[0] - u[0] * n[2], u[0] * n[1] - u[1] * n[0]];
+        let d_uxn = d[0] * uxn[0] + d[1] * uxn[1] + d[2] * uxn[2];
+        [-self.rhs * d_uxn, -du + dn * nu, -dn]
+    }
+
+    /// The Klems patch `kbin(N, U)` gives a ray direction `d` (unit length): the patch of `-d`.
+    pub fn bin(&self, basis: &KlemsBasis, d: [f64; 3]) -> Option<usize> {
+        let l = self.reversed_local(d);
+        const DEGREE: f64 = PI / 180.0;
+        let z = l[2];
+        let theta = if z > 1.0 {
+            0.0
+        } else if z < -1.0 {
+            180.0
+        } else {
+            z.acos() / DEGREE
+        };
+        if theta > 90.0 {
+            return None;
+        }
+        let mut a = l[1].atan2(l[0]);
+        if a < 0.0 {
+            a += 2.0 * PI;
+        }
+        basis.patch_at(theta, a / DEGREE)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn all() -> [&'static KlemsBasis; 3] {
+        [KlemsBasis::full(), KlemsBasis::half(), KlemsBasis::quarter()]
+    }
+
+    #[test]
+    fn sizes() {
+        assert_eq!(KlemsBasis::full().len(), 145);
+        assert_eq!(KlemsBasis::half().len(), 77);
+        assert_eq!(KlemsBasis::quarter().len(), 41);
+    }
+
+    #[test]
+    fn sums_are_2pi_and_pi() {
+        for b in all() {
+            let omega: f64 = (0..b.len()).map(|p| b.solid_angle(p).unwrap()).sum();
+            let lambda: f64 = b.lambdas().iter().sum();
+            assert!((omega - 2.0 * PI).abs() < 1e-12, "{} {omega}", b.name());
+            assert!((lambda - PI).abs() < 1e-12, "{} {lambda}", b.name());
+        }
+    }
+
+    #[test]
+    fn spec_table_values() {
+        // formats.md §3.1 tables, printed to 7 significant digits.
+        let f = KlemsBasis::full();
+        assert!((f.solid_angle(133).unwrap() / 1.355173e-01 - 1.0).abs() < 1e-6);
+        assert!((f.projected_solid_angle(0).unwrap() / 2.386393e-02 - 1.0).abs() < 1e-6);
+        let h = KlemsBasis::half();
+        assert!((h.projected_solid_angle(70).unwrap() / 3.953783e-02 - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn centres_and_samples_map_back() {
+        for b in all() {
+            for p in 0..b.len() {
+                assert_eq!(b.patch(b.centre(p).unwrap()), Some(p), "{} centre {p}", b.name());
+                for (u0, u1) in [(0.01, 0.02), (0.5, 0.5), (0.98, 0.97), (0.3, 0.999)] {
+                    assert_eq!(b.patch(b.sample_projected(p, u0, u1).unwrap()), Some(p));
+                    assert_eq!(b.patch(b.sample_uniform(p, u0, u1).unwrap()), Some(p));
+                }
+                let r = b.rotate180(p).unwrap();
+                assert_eq!(b.rotate180(r), Some(p));
+            }
+        }
+    }
+
+    #[test]
+    fn edges() {
+        let f = KlemsBasis::full();
+        assert_eq!(f.patch([0.0, 0.0, 1.0]), Some(0));
+        assert_eq!(f.patch([1.0, 0.0, 0.0]), Some(133));
+        assert_eq!(f.patch([0.0, 0.0, -1.0]), None);
+        assert_eq!(f.patch([0.0, 0.0, 0.0]), None);
+        assert_eq!(f.patch([f64::NAN, 0.0, 1.0]), None);
+        assert_eq!(f.patch_at(5.0, 0.0), Some(0));
+        assert_eq!(f.patch_at(90.0, 359.9), Some(133));
+        // klems_full.cal verified examples (kbinN: N = (0,-1,0), U = +Z).
+        let north = Frame::new([0.0, -1.0, 0.0], [0.0, 0.0, 1.0]);
+        let s10 = 10f64.to_radians().sin();
+        let c10 = 10f64.to_radians().cos();
+        assert_eq!(north.bin(f, [0.0, 1.0, 0.0]), Some(0));
+        assert_eq!(north.bin(f, [s10, c10, 0.0]), Some(5));
+        assert_eq!(north.bin(f, [-s10, c10, 0.0]), Some(1));
+        assert_eq!(north.bin(f, [0.0, c10, s10]), Some(7));
+        assert_eq!(north.bin(f, [0.0, c10, -s10]), Some(3));
+        assert_eq!(north.bin(f, [0.0, -1.0, 0.0]), None);
+        let s = 0.5f64.hypot(0.5).hypot(0.7071);
+        assert_eq!(north.bin(f, [0.5 / s, 0.5 / s, 0.7071 / s]), Some(109));
+    }
+
+    #[test]
+    fn custom_basis_checks() {
+        assert!(KlemsBasis::from_bounds("x", &[]).is_err());
+        assert!(KlemsBasis::from_bounds("x", &[(10.0, 1), (80.0, 4)]).is_err());
+        assert!(KlemsBasis::from_bounds("x", &[(10.0, 1), (90.0, 1)]).is_err());
+        let b = KlemsBasis::from_bounds("x", &[(30.0, 1), (90.0, 6)]).unwrap();
+        assert_eq!(b.len(), 7);
+        assert_eq!(KlemsBasis::by_name("lbnl/klems full").unwrap().len(), 145);
+    }
+}
