@@ -38,7 +38,11 @@ fn check(file: &str, basis: &KlemsBasis) {
     let (mut rows, mut neighbour) = (0, 0);
     for line in text.lines().skip(1) {
         let f: Vec<&str> = line.split('\t').collect();
-        let d = [f[1].parse().unwrap(), f[2].parse().unwrap(), f[3].parse().unwrap()];
+        let d = [
+            f[1].parse().unwrap(),
+            f[2].parse().unwrap(),
+            f[3].parse().unwrap(),
+        ];
         let kind: u32 = f[4].parse().unwrap();
         for (c, frame) in frames.iter().enumerate() {
             let want: i64 = f[5 + c].parse().unwrap();
@@ -51,7 +55,10 @@ fn check(file: &str, basis: &KlemsBasis) {
                 neighbour += 1;
                 continue;
             }
-            panic!("{file} row {} column {c} kind {kind}: oracle {want:?}, fenestra {got:?}", f[0]);
+            panic!(
+                "{file} row {} column {c} kind {kind}: oracle {want:?}, fenestra {got:?}",
+                f[0]
+            );
         }
         rows += 1;
     }
