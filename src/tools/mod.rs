@@ -7,6 +7,8 @@ pub mod gendaylit;
 pub mod gendaymtx;
 pub mod gensky;
 pub mod genskyvec;
+pub mod view_opts;
+pub mod vwrays;
 
 /// A tool's entry point.
 pub type Run = fn(Vec<String>) -> anyhow::Result<ExitCode>;
@@ -17,5 +19,6 @@ pub fn registry() -> &'static [(&'static str, Run)] {
         ("gendaymtx", gendaymtx::run),
         ("gensky", gensky::run),
         ("genskyvec", genskyvec::run),
+        ("vwrays", vwrays::run),
     ]
 }
