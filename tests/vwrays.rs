@@ -41,7 +41,9 @@ fn documented_examples() {
         out.lines().next().unwrap(),
         "0.00000e+00 0.00000e+00 0.00000e+00 -4.08248e-01 8.16497e-01 4.08248e-01"
     );
-    let d = ours(&["-d", "-x", "100", "-y", "50", "-vtv", "-vh", "60", "-vv", "60", "-va", "10"]);
+    let d = ours(&[
+        "-d", "-x", "100", "-y", "50", "-vtv", "-vh", "60", "-vv", "60", "-va", "10",
+    ]);
     assert_eq!(String::from_utf8(d).unwrap(), "-x 50 -y 50 -ld+\n");
     let d = ours(&["-d", "-vf", &vf(), "-x", "32", "-y", "32"]);
     assert_eq!(String::from_utf8(d).unwrap(), "-x 32 -y 26\n");
@@ -76,17 +78,26 @@ fn bad_input_gives_clear_errors() {
     for (args, want) in [
         (&["-x", "0", "-vtv"][..], "bad x resolution"),
         (&["-vtq"][..], "unknown view type"),
-        (&["-vu", "0", "1", "0"][..], "view up parallel to view direction"),
+        (
+            &["-vu", "0", "1", "0"][..],
+            "view up parallel to view direction",
+        ),
         (&["-vf", "no/such.vf"][..], "no/such.vf"),
         (&["-fz"][..], "-fz"),
     ] {
         let out = common::fenestra("vwrays").args(args).output().unwrap();
         assert!(!out.status.success(), "{args:?}");
         let err = String::from_utf8_lossy(&out.stderr);
-        assert!(err.contains("vwrays: fatal - ") && err.contains(want), "{args:?}: {err}");
+        assert!(
+            err.contains("vwrays: fatal - ") && err.contains(want),
+            "{args:?}: {err}"
+        );
     }
     let mut c = common::fenestra("vwrays");
-    c.args(["-i", "-vtv"]).stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::piped());
+    c.args(["-i", "-vtv"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
     let mut child = c.spawn().unwrap();
     child.stdin.take().unwrap().write_all(b"1 x\n").unwrap();
     let out = child.wait_with_output().unwrap();
@@ -100,7 +111,9 @@ fn cases() -> Vec<Vec<String>> {
     let mut push = |s: String| all.push(s.split_whitespace().map(str::to_string).collect());
     for t in ["v", "l", "a", "h", "s", "c"] {
         push(format!("-vt{t} -vp 1 2 3 -vd 0.3 -1 0.2 -vu 0 0 1 -vh 100 -vv 80 -vs 0.1 -vl -0.2 -x 37 -y 29 -pa 0"));
-        push(format!("-vt{t} -vf {vf} -vh 170 -vv 150 -x 40 -y 40 -vo 0.5 -va 7"));
+        push(format!(
+            "-vt{t} -vf {vf} -vh 170 -vv 150 -x 40 -y 40 -vo 0.5 -va 7"
+        ));
         push(format!("-vt{t} -vh 120 -vv 60 -x 17 -y 33 -d"));
     }
     push(format!("-vf {vf} -x 32 -y 32"));
@@ -134,12 +147,11 @@ fn oracle_vwrays_binary() {
     let vf = vf();
     for t in ["v", "l", "a", "h", "s", "c"] {
         for fmt in ["-ff", "-fd"] {
-            let args: Vec<String> = format!(
-                "{fmt} -vt{t} -vf {vf} -vh 100 -vv 100 -x 32 -y 32 -vo 1 -va 9 -vs 0.05"
-            )
-            .split_whitespace()
-            .map(str::to_string)
-            .collect();
+            let args: Vec<String> =
+                format!("{fmt} -vt{t} -vf {vf} -vh 100 -vv 100 -x 32 -y 32 -vo 1 -va 9 -vs 0.05")
+                    .split_whitespace()
+                    .map(str::to_string)
+                    .collect();
             let want = common::run_ok(o.command("vwrays").args(&args));
             let got = common::run_ok(common::fenestra("vwrays").args(&args));
             assert_eq!(want.len(), got.len(), "{args:?}");

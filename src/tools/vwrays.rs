@@ -1,4 +1,6 @@
 //! vwrays: ray origins and directions for every pixel of a view or picture.
+// Component-wise vector arithmetic reads most clearly with explicit indices.
+#![allow(clippy::needless_range_loop)]
 
 use std::io::{BufRead, Read, Write};
 use std::process::ExitCode;
@@ -115,8 +117,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         view = v;
         let res = read_resolution(&mut r).with_context(|| format!("picture '{pic}'"))?;
         if let Some(z) = pos.get(1) {
-            let f = std::fs::File::open(z)
-                .with_context(|| format!("cannot open z-buffer '{z}'"))?;
+            let f =
+                std::fs::File::open(z).with_context(|| format!("cannot open z-buffer '{z}'"))?;
             zbuf = Some(Box::new(std::io::BufReader::new(f)));
         }
         Some(res)
@@ -316,10 +318,16 @@ fn pix2rays(
         }
         while pending.len() >= 2 {
             let px: f64 = pending[0].parse().map_err(|_| {
-                anyhow::anyhow!("input line {lineno}: expected 'x y' pixel position, got '{}'", pending[0])
+                anyhow::anyhow!(
+                    "input line {lineno}: expected 'x y' pixel position, got '{}'",
+                    pending[0]
+                )
             })?;
             let py: f64 = pending[1].parse().map_err(|_| {
-                anyhow::anyhow!("input line {lineno}: expected 'x y' pixel position, got '{}'", pending[1])
+                anyhow::anyhow!(
+                    "input line {lineno}: expected 'x y' pixel position, got '{}'",
+                    pending[1]
+                )
             })?;
             pending.drain(..2);
             let loc = [(px + 0.5) / res.xr as f64, (py + 0.5) / res.yr as f64];
@@ -338,7 +346,10 @@ fn pix2rays(
         }
     }
     if !pending.is_empty() {
-        bail!("expected 'x y' pixel position on input, got a lone '{}'", pending[0]);
+        bail!(
+            "expected 'x y' pixel position on input, got a lone '{}'",
+            pending[0]
+        );
     }
     Ok(())
 }

@@ -1,6 +1,8 @@
 //! Radiance HDR pictures (`.hdr`/`.pic`): header, resolution string and RGBE/XYZE
 //! scanlines in any of the eight orientations; written in the standard orientation
 //! with the new run-length encoding.
+// Component-wise vector arithmetic reads most clearly with explicit indices.
+#![allow(clippy::needless_range_loop)]
 
 use std::io::{BufRead, Read, Write};
 
@@ -134,9 +136,10 @@ impl PictureInfo {
                 continue;
             }
             if let Some(v) = l.strip_prefix("EXPOSURE=") {
-                let e: f64 = v.trim().parse().map_err(|_| {
-                    PictureError::Header(format!("bad EXPOSURE value in '{l}'"))
-                })?;
+                let e: f64 = v
+                    .trim()
+                    .parse()
+                    .map_err(|_| PictureError::Header(format!("bad EXPOSURE value in '{l}'")))?;
                 info.exposure *= e;
             } else if let Some(v) = l.strip_prefix("COLORCORR=") {
                 let w: Vec<f64> = v
@@ -150,9 +153,10 @@ impl PictureInfo {
                     info.colorcorr[k] *= w[k];
                 }
             } else if let Some(v) = l.strip_prefix("PIXASPECT=") {
-                let a: f64 = v.trim().parse().map_err(|_| {
-                    PictureError::Header(format!("bad PIXASPECT value in '{l}'"))
-                })?;
+                let a: f64 = v
+                    .trim()
+                    .parse()
+                    .map_err(|_| PictureError::Header(format!("bad PIXASPECT value in '{l}'")))?;
                 info.pixaspect *= a;
             }
             if View::is_view_line(l, prog) && view.scan_line(l) > 0 {
@@ -325,7 +329,12 @@ mod tests {
                 if i % 11 == 5 {
                     return [0.0; 3];
                 }
-                rgbe::decode([200, (i % 200) as u8, (i * 3 % 200) as u8, 120 + (i % 20) as u8])
+                rgbe::decode([
+                    200,
+                    (i % 200) as u8,
+                    (i * 3 % 200) as u8,
+                    120 + (i % 20) as u8,
+                ])
             })
             .collect()
     }
@@ -370,8 +379,8 @@ mod tests {
         assert!(e.to_string().contains("not a Radiance picture"), "{e}");
         let e = Picture::read(&mut &b"#?RADIANCE\n\n-Y 1\n"[..], "t").unwrap_err();
         assert!(e.to_string().contains("resolution"), "{e}");
-        let e = Picture::read(&mut &b"#?RADIANCE\n\n-Y 2 +X 1\n\x01\x02\x03\x04"[..], "t")
-            .unwrap_err();
+        let e =
+            Picture::read(&mut &b"#?RADIANCE\n\n-Y 2 +X 1\n\x01\x02\x03\x04"[..], "t").unwrap_err();
         assert!(e.to_string().contains("scanline 1 of 2"), "{e}");
     }
 

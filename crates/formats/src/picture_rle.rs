@@ -1,5 +1,7 @@
 //! Scanline coding of Radiance pictures: flat pixels, old-style repeat markers and
 //! the newer per-component run-length encoding, read and written as Radiance does.
+// Component-wise vector arithmetic reads most clearly with explicit indices.
+#![allow(clippy::needless_range_loop)]
 
 use std::io::{self, Read, Write};
 
@@ -241,7 +243,13 @@ mod tests {
         let data = [5u8, 6, 7, 8, 1, 1, 1, 3, 9, 9, 9, 9];
         let mut scan = vec![[0u8; 4]; 5];
         read_scanline(&mut &data[..], &mut scan).unwrap();
-        assert_eq!(scan, vec![[5, 6, 7, 8]; 4].into_iter().chain([[9, 9, 9, 9]]).collect::<Vec<_>>());
+        assert_eq!(
+            scan,
+            vec![[5, 6, 7, 8]; 4]
+                .into_iter()
+                .chain([[9, 9, 9, 9]])
+                .collect::<Vec<_>>()
+        );
     }
 
     #[test]

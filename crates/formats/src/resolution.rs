@@ -171,7 +171,14 @@ mod tests {
 
     #[test]
     fn garbage_is_rejected() {
-        for s in ["", "-Y 2", "-Y 2 +Y 3", "Y 2 X 3", "-Y a +X 3", "-Y 2 +X 3 4"] {
+        for s in [
+            "",
+            "-Y 2",
+            "-Y 2 +Y 3",
+            "Y 2 X 3",
+            "-Y a +X 3",
+            "-Y 2 +X 3 4",
+        ] {
             assert_eq!(Resolution::parse(s), None, "{s}");
         }
     }

@@ -82,7 +82,7 @@ mod tests {
     #[test]
     fn one_encodes_and_decodes_as_radiance() {
         assert_eq!(encode([1.0, 1.0, 1.0]), [128, 128, 128, 129]);
-        assert_eq!(decode([128, 128, 128, 129]), [1.00390625; 3]);
+        assert_eq!(decode([128, 128, 128, 129]), [1.0 + 1.0 / 256.0; 3]);
     }
 
     #[test]

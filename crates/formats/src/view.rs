@@ -1,6 +1,8 @@
 //! Radiance view parameters: parsing (`-vt? -vp -vd -vu -vh -vv -vo -va -vs -vl`, `VIEW=`
 //! lines, view files), checking and deriving the image plane (`setview`), mapping image
 //! locations to rays (`viewray`) and printing them back as a `VIEW=` line.
+// Component-wise vector arithmetic reads most clearly with explicit indices.
+#![allow(clippy::needless_range_loop)]
 
 use std::f64::consts::PI;
 
@@ -159,11 +161,15 @@ impl View {
         };
         let vec3 = || -> Result<[f64; 3], String> { Ok([num(1)?, num(2)?, num(3)?]) };
         let mut chars = rest.chars();
-        let c = chars.next().ok_or_else(|| format!("unknown view option '{opt}'"))?;
+        let c = chars
+            .next()
+            .ok_or_else(|| format!("unknown view option '{opt}'"))?;
         let tail: String = chars.collect();
         if c == 't' {
             let mut t = tail.chars();
-            let letter = t.next().ok_or_else(|| format!("option {opt} needs a type letter"))?;
+            let letter = t
+                .next()
+                .ok_or_else(|| format!("option {opt} needs a type letter"))?;
             if t.next().is_some() {
                 return Err(format!("unknown view type '{opt}'"));
             }
@@ -564,11 +570,15 @@ mod tests {
 
     #[test]
     fn errors_are_reported() {
-        let mut v = View::default();
-        v.vup = [0.0, 1.0, 0.0];
+        let mut v = View {
+            vup: [0.0, 1.0, 0.0],
+            ..Default::default()
+        };
         assert_eq!(v.setup().unwrap_err(), "view up parallel to view direction");
-        let mut v = View::default();
-        v.horiz = 180.0;
+        let mut v = View {
+            horiz: 180.0,
+            ..Default::default()
+        };
         assert_eq!(v.setup().unwrap_err(), "illegal horizontal view size");
         let mut v = View::default();
         assert!(v.apply_option(&words("-vtx")).is_err());
