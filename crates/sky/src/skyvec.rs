@@ -145,9 +145,10 @@ pub fn sky_vector(
                 let d = sample_dir(&basis, b, x1, x2).map(|v| f64::from(v as f32));
                 let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
                 let d = [d[0] / len, d[1] / len, d[2] / len];
-                let v = radiance(d);
+                // rtrace keeps the pattern value and the colour in single precision
+                let v = radiance(d) as f32;
                 for k in 0..3 {
-                    sum[k] += f64::from((f64::from(color[k]) * v) as f32);
+                    sum[k] += f64::from(color[k] * v);
                 }
             }
             Row::Mean(sum.map(|s| s / 16.0))
