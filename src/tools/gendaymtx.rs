@@ -149,7 +149,10 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         fenestra_cli::warn(format!("{label}: {w}"));
     }
     if mods.is_some() && matches!(suns, SunOut::None) {
-        fenestra_cli::warn("-M output will be empty without -D");
+        eprintln!(
+            "{}: warning -M output will be empty without -D",
+            fenestra_cli::prog()
+        );
     }
     let basis = Reinhart::new(o.mf);
     if verbose {
