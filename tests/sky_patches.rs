@@ -26,6 +26,18 @@ fn direction_to_patch_matches_reinhart_cal() {
             if got != want {
                 bad.push((f[0].to_string(), f[4].to_string(), want, got));
             }
+            // reinhartb.cal (oracle library version): 0-based sky bins, -1 for the ground
+            let want_b: i64 = f[7].parse().unwrap();
+            let got_b = basis.sky_index_b(d).map_or(-1, |v| v as i64);
+            if got_b != want_b {
+                bad.push((
+                    f[0].to_string(),
+                    format!("{} (reinhartb)", f[4]),
+                    want_b as usize,
+                    got_b as usize,
+                ));
+            }
+            assert_eq!(f[8].parse::<usize>().unwrap(), basis.sky_patches());
             n += 1;
         }
         // Every direction, including those exactly on boundaries (kinds 3, 6) and in

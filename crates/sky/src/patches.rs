@@ -165,6 +165,39 @@ impl Reinhart {
         };
         self.row_start[r] + c
     }
+    /// Sky patch index (0..N−1, no ground) of direction `d` in the default frame
+    /// (+Z up, +Y north) as `reinhartb.cal` (the library version used by rfluxmtx)
+    /// computes it: `None` for the ground **and the exact horizon**, the 1e-4°
+    /// azimuth wrap quirk kept, and a true division by the row height (which that
+    /// file defines as a variable, not a constant).
+    pub fn sky_index_b(&self, d: [f64; 3]) -> Option<usize> {
+        let degree = PI / 180.0;
+        let asin = if d[2] - 1.0 > 0.0 {
+            PI / 2.0
+        } else if -1.0 - d[2] > 0.0 {
+            -PI / 2.0
+        } else {
+            d[2].asin()
+        };
+        let alt = asin * (1.0 / degree);
+        if alt <= 0.0 {
+            return None;
+        }
+        let mut azi = d[0].atan2(d[1]);
+        if -azi > 0.0 {
+            azi += 2.0 * PI;
+        }
+        let azi = azi * (1.0 / degree);
+        let alpha = 90.0 / (self.mf as f64 * 7.0 + 0.5);
+        let r = ((alt / alpha).floor() as usize).min(self.rows() - 1);
+        let inc = 360.0 / self.row_len[r] as f64;
+        let c = if 359.9999 - 0.5 * inc - azi > 0.0 {
+            ((azi + 0.5 * inc) / inc).floor() as usize
+        } else {
+            0
+        };
+        Some(self.row_start[r] - 1 + c)
+    }
 }
 
 #[cfg(test)]
