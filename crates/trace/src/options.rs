@@ -1,0 +1,79 @@
+//! Rendering options shared by rtrace and rcontrib (`-ab -ad -lw -lr -ds -dj …`).
+
+/// Options of the integrator (Radiance names in the field docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TraceOptions {
+    /// `-ab`: ambient bounces.
+    pub ab: u32,
+    /// `-ad`: ambient divisions.
+    pub ad: u32,
+    /// `-lw`: minimum ray weight.
+    pub lw: f64,
+    /// `-lr`: maximum reflections (negative: Russian roulette with that hard limit).
+    pub lr: i32,
+    /// `-ds`: source subdivision ratio (0 = none).
+    pub ds: f64,
+    /// `-dj`: source jitter (0..1).
+    pub dj: f64,
+    /// `-dc`: source certainty (accepted; every shadow ray is traced).
+    pub dc: f64,
+    /// `-dr`: relays (accepted; virtual sources are not modelled).
+    pub dr: i32,
+    /// `-dt`: direct threshold (accepted; every shadow ray is traced, as with `-dt 0`).
+    pub dt: f64,
+    /// `-st`: specular sampling threshold.
+    pub st: f64,
+    /// `-ss`: specular sampling (0 = no rough-specular indirect samples).
+    pub ss: f64,
+    /// `-bv`: back faces of emitters visible.
+    pub bv: bool,
+    /// `-av`: ambient value beyond the last bounce.
+    pub av: [f64; 3],
+    /// Seed of the random streams (each input ray gets its own stream).
+    pub seed: u64,
+    /// Disable effect selection (run the full integrator; for tests and benchmarks).
+    pub full: bool,
+}
+
+impl TraceOptions {
+    /// rtrace's defaults (`-ab 0 -ad 1024 -lw 1e-4 -lr -10 -dt .03 -dj 0 -st .15`).
+    pub fn rtrace() -> Self {
+        TraceOptions {
+            ab: 0,
+            ad: 1024,
+            lw: 1e-4,
+            lr: -10,
+            ds: 0.2,
+            dj: 0.0,
+            dc: 0.75,
+            dr: 2,
+            dt: 0.03,
+            st: 0.15,
+            ss: 1.0,
+            bv: true,
+            av: [0.0; 3],
+            seed: 0,
+            full: false,
+        }
+    }
+
+    /// rcontrib's defaults (`-ab 1 -ad 350 -lw 2e-3 -dj .9 -dr 3 -st .02`, `-dt 0`).
+    pub fn rcontrib() -> Self {
+        TraceOptions {
+            ab: 1,
+            ad: 350,
+            lw: 2e-3,
+            dj: 0.9,
+            dr: 3,
+            dt: 0.0,
+            st: 0.02,
+            ..Self::rtrace()
+        }
+    }
+}
+
+impl Default for TraceOptions {
+    fn default() -> Self {
+        Self::rtrace()
+    }
+}

@@ -1,0 +1,1187 @@
+//! The integrator: Radiance's shading rules with `-aa 0` (pure Monte Carlo).
+//!
+//! Every ray carries Radiance's ray-type flags (inherited from its parent), its weight
+//! (for `-lw`/`-lr`) and its path coefficient (product of the coefficients back to the
+//! primary ray, which rcontrib records). Random numbers come from one stream per input
+//! ray ([`Rng::for_ray`]), used in a fixed order, so results do not depend on threads.
+
+use std::collections::HashMap;
+use std::f64::consts::PI;
+
+use anyhow::{bail, Result};
+use fenestra_scene::Scene;
+use glam::DVec3;
+
+use crate::bvh::Accel;
+use crate::material::{compile, is_pattern, LightKind, Material, FTINY};
+use crate::options::TraceOptions;
+use crate::polygon::Polygon;
+use crate::rng::Rng;
+use crate::shape::Shape;
+
+const SHADOW: u8 = 1;
+const REFLECTED: u8 = 2;
+const TRANS: u8 = 4;
+const AMBIENT: u8 = 8;
+const SPECULAR: u8 = 16;
+
+/// One recorded contribution: a ray that reached a surface (or distant source) whose
+/// direct modifier is tracked.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Contribution {
+    /// Scene index of the tracked modifier.
+    pub modifier: usize,
+    /// Path coefficient: product of the ray's and its ancestors' coefficients (rcontrib `-V-`).
+    pub coef: [f64; 3],
+    /// `coef` times the radiance the ray brought back (rcontrib `-V+`).
+    pub value: [f64; 3],
+    /// Origin of the ray that hit.
+    pub org: DVec3,
+    /// Its unit direction (`Dx Dy Dz`).
+    pub dir: DVec3,
+    /// Hit point (`Px Py Pz`); the ray origin for a distant source.
+    pub hit: DVec3,
+    /// Surface normal at the hit (`Nx Ny Nz`); `-dir` for a distant source.
+    pub normal: DVec3,
+    /// Distance from the primary ray's origin (`T`); 1e10 or more for a distant source.
+    pub total_dist: f64,
+    /// Length of this ray segment (`Ts`).
+    pub dist: f64,
+}
+
+#[derive(Debug, Clone)]
+struct Ray {
+    org: DVec3,
+    dir: DVec3,
+    tmax: f64,
+    flags: u8,
+    weight: f64,
+    coef: DVec3,
+    depth: i32,
+    amb: u32,
+    src: Option<usize>,
+    skip: Option<usize>,
+    /// Distance travelled before this ray's origin.
+    start: f64,
+}
+
+struct Ctx<'a> {
+    rng: Rng,
+    tracked: &'a [bool],
+    sink: Option<&'a mut dyn FnMut(Contribution)>,
+}
+
+#[derive(Debug, Clone)]
+enum SourceGeom {
+    Local(usize),
+    Distant(usize),
+}
+
+#[derive(Debug, Clone)]
+struct Source {
+    geom: SourceGeom,
+    /// Scene index of the emitting material.
+    mat: usize,
+    /// Scene index of the surface.
+    prim: usize,
+}
+
+#[derive(Debug, Clone)]
+struct Distant {
+    prim: usize,
+    mat: usize,
+    dir: DVec3,
+    cos_half: f64,
+    omega: f64,
+    glow: bool,
+}
+
+/// What the integrator switched on, and why (printed by `-v`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Effects {
+    /// Shadow rays to light sources.
+    pub direct: bool,
+    /// Ambient (indirect diffuse) sampling.
+    pub ambient: bool,
+    /// Specular reflection/transmission rays.
+    pub specular: bool,
+    /// One line per effect with its reason.
+    pub notes: Vec<String>,
+}
+
+/// A scene prepared for tracing.
+pub struct Tracer {
+    accel: Accel,
+    /// Scene index of each BVH shape's surface.
+    surf_prim: Vec<usize>,
+    /// Scene index of each BVH shape's material.
+    surf_mat: Vec<usize>,
+    mats: HashMap<usize, Material>,
+    /// Scene index of the direct modifier of every primitive.
+    modifier_of: Vec<Option<usize>>,
+    distant: Vec<Distant>,
+    sources: Vec<Source>,
+    opts: TraceOptions,
+    effects: Effects,
+    warnings: Vec<String>,
+}
+
+fn maxc(c: DVec3) -> f64 {
+    c.max_element()
+}
+
+impl Tracer {
+    /// Prepares `scene` for tracing with `opts`.
+    pub fn new(scene: &Scene, opts: &TraceOptions) -> Result<Tracer> {
+        let mut shapes = Vec::new();
+        let mut surf_prim = Vec::new();
+        let mut surf_mat = Vec::new();
+        let mut mats: HashMap<usize, Material> = HashMap::new();
+        let mut distant = Vec::new();
+        let mut warnings = Vec::new();
+        let need_mat = |m: usize, mats: &mut HashMap<usize, Material>| -> Result<()> {
+            if mats.contains_key(&m) {
+                return Ok(());
+            }
+            let p = &scene.prims[m];
+            if is_pattern(&p.ptype) {
+                bail!(
+                    "{}: '{}' is a {} (pattern), used where a material is expected",
+                    p.loc,
+                    p.name,
+                    p.ptype
+                );
+            }
+            if let Some(&k) = scene.modifier_chain(m).first() {
+                let q = &scene.prims[k];
+                bail!(
+                    "{}: {} '{}' modifies material '{}': patterns and textures are not supported by fenestra's ray tracer in this build",
+                    q.loc, q.ptype, q.name, p.name
+                );
+            }
+            let mat = compile(scene, m)?;
+            if let Material::Light {
+                kind: LightKind::Illum(Some(a)),
+                ..
+            } = &mat
+            {
+                let a = *a;
+                mats.insert(m, mat);
+                let alt = compile(scene, a)?;
+                mats.insert(a, alt);
+                return Ok(());
+            }
+            mats.insert(m, mat);
+            Ok(())
+        };
+        for (i, p) in scene.prims.iter().enumerate() {
+            if !p.is_surface() {
+                continue;
+            }
+            let Some(m) = p.modifier else { continue };
+            let r = &p.rargs;
+            let bad = |what: &str| anyhow::anyhow!("{}: {} '{}': {what}", p.loc, p.ptype, p.name);
+            let shape = match p.ptype.as_str() {
+                "polygon" => {
+                    if r.len() % 3 != 0 {
+                        return Err(bad("polygon needs a multiple of 3 real arguments"));
+                    }
+                    let verts: Vec<DVec3> =
+                        r.chunks(3).map(|c| DVec3::new(c[0], c[1], c[2])).collect();
+                    match Polygon::new(verts) {
+                        Ok((poly, warn)) => {
+                            if let Some(w) = warn {
+                                warnings.push(format!("{}: polygon '{}': {w}", p.loc, p.name));
+                            }
+                            Shape::Polygon(poly)
+                        }
+                        Err(e) => {
+                            warnings.push(format!("{}: polygon '{}': {e}; ignored", p.loc, p.name));
+                            continue;
+                        }
+                    }
+                }
+                "sphere" | "bubble" => {
+                    if r.len() != 4 || r[3] <= 0.0 {
+                        return Err(bad("needs 4 real arguments (centre, radius > 0)"));
+                    }
+                    Shape::Sphere {
+                        c: DVec3::new(r[0], r[1], r[2]),
+                        r: r[3],
+                        inward: p.ptype == "bubble",
+                    }
+                }
+                "cone" | "cup" | "cylinder" | "tube" => {
+                    let cyl = p.ptype == "cylinder" || p.ptype == "tube";
+                    if r.len() != if cyl { 7 } else { 8 } {
+                        return Err(bad("wrong number of real arguments"));
+                    }
+                    let p0 = DVec3::new(r[0], r[1], r[2]);
+                    let p1 = DVec3::new(r[3], r[4], r[5]);
+                    let (r0, r1) = if cyl { (r[6], r[6]) } else { (r[6], r[7]) };
+                    let len = (p1 - p0).length();
+                    if len <= 0.0 || r0 < 0.0 || r1 < 0.0 || (r0 == 0.0 && r1 == 0.0) {
+                        warnings.push(format!(
+                            "{}: {} '{}' is degenerate; ignored",
+                            p.loc, p.ptype, p.name
+                        ));
+                        continue;
+                    }
+                    Shape::Cone {
+                        p0,
+                        axis: (p1 - p0) / len,
+                        len,
+                        r0,
+                        r1,
+                        inward: p.ptype == "cup" || p.ptype == "tube",
+                    }
+                }
+                "ring" => {
+                    if r.len() != 8 {
+                        return Err(bad("needs 8 real arguments"));
+                    }
+                    let n = DVec3::new(r[3], r[4], r[5]);
+                    if n.length() == 0.0 || r[6] < 0.0 || r[7] <= r[6] {
+                        warnings.push(format!(
+                            "{}: ring '{}' is degenerate; ignored",
+                            p.loc, p.name
+                        ));
+                        continue;
+                    }
+                    Shape::Ring {
+                        c: DVec3::new(r[0], r[1], r[2]),
+                        n: n.normalize(),
+                        r0: r[6],
+                        r1: r[7],
+                    }
+                }
+                "source" => {
+                    if r.len() != 4 {
+                        return Err(bad("needs 4 real arguments"));
+                    }
+                    need_mat(m, &mut mats)?;
+                    let dir = DVec3::new(r[0], r[1], r[2]).normalize_or_zero();
+                    if dir == DVec3::ZERO {
+                        return Err(bad("zero direction"));
+                    }
+                    let cos_half = (r[3].to_radians() * 0.5).cos();
+                    let glow = matches!(
+                        mats[&m],
+                        Material::Light {
+                            kind: LightKind::Glow(_),
+                            ..
+                        }
+                    );
+                    if !mats[&m].is_light() {
+                        return Err(bad(
+                            "a distant source needs a light, glow, illum or spotlight material",
+                        ));
+                    }
+                    distant.push(Distant {
+                        prim: i,
+                        mat: m,
+                        dir,
+                        cos_half,
+                        omega: 2.0 * PI * (1.0 - cos_half),
+                        glow,
+                    });
+                    continue;
+                }
+                other => bail!(
+                    "{}: surface type '{other}' of '{}' is not supported by fenestra's ray tracer",
+                    p.loc,
+                    p.name
+                ),
+            };
+            need_mat(m, &mut mats)?;
+            shapes.push(shape);
+            surf_prim.push(i);
+            surf_mat.push(m);
+        }
+        // light sources
+        let mut sources = Vec::new();
+        for (s, &m) in surf_mat.iter().enumerate() {
+            if let Material::Light { color, kind } = &mats[&m] {
+                let active = maxc(*color) > FTINY
+                    && match kind {
+                        LightKind::Glow(r) => *r > FTINY,
+                        _ => true,
+                    };
+                if active {
+                    if matches!(shapes[s], Shape::Cone { .. }) {
+                        bail!("{}: cone and cylinder light sources are not supported by fenestra's ray tracer", scene.prims[surf_prim[s]].loc);
+                    }
+                    sources.push(Source {
+                        geom: SourceGeom::Local(s),
+                        mat: m,
+                        prim: surf_prim[s],
+                    });
+                }
+            }
+        }
+        for (k, d) in distant.iter().enumerate() {
+            if let Material::Light { color, .. } = &mats[&d.mat] {
+                if !d.glow && maxc(*color) > FTINY {
+                    sources.push(Source {
+                        geom: SourceGeom::Distant(k),
+                        mat: d.mat,
+                        prim: d.prim,
+                    });
+                }
+            }
+        }
+        let modifier_of = scene.prims.iter().map(|p| p.modifier).collect();
+        let specular = mats.values().any(|m| match m {
+            Material::Mirror { .. } | Material::Glass { .. } => true,
+            Material::Normal {
+                spec, trans, tspec, ..
+            } => *spec > FTINY || (*trans > FTINY && *tspec > FTINY),
+            Material::Light { .. } => false,
+        });
+        let mut notes = Vec::new();
+        let direct = !sources.is_empty() || opts.full;
+        notes.push(if sources.is_empty() {
+            "direct: off (no light sources in the scene)".to_string()
+        } else {
+            format!("direct: on ({} light source(s))", sources.len())
+        });
+        let ambient = opts.ab > 0 || opts.full;
+        notes.push(if opts.ab > 0 {
+            format!("ambient: on (-ab {})", opts.ab)
+        } else {
+            "ambient: off (-ab 0)".into()
+        });
+        notes.push(if specular {
+            "specular: on (specular materials present)".into()
+        } else {
+            "specular: off (no specular materials)".into()
+        });
+        if opts.full {
+            notes.push("effect selection disabled: full integrator".into());
+        }
+        let specular = specular || opts.full;
+        Ok(Tracer {
+            accel: Accel::new(shapes),
+            surf_prim,
+            surf_mat,
+            mats,
+            modifier_of,
+            distant,
+            sources,
+            opts: opts.clone(),
+            effects: Effects {
+                direct,
+                ambient,
+                specular,
+                notes,
+            },
+            warnings,
+        })
+    }
+
+    /// Warnings found while preparing the scene (degenerate polygons …).
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    /// The effects switched on for this scene and options.
+    pub fn effects(&self) -> &Effects {
+        &self.effects
+    }
+
+    /// Number of light sources used for direct lighting.
+    pub fn source_count(&self) -> usize {
+        self.sources.len()
+    }
+
+    fn primary(org: DVec3, dir: DVec3) -> Ray {
+        Ray {
+            org,
+            dir,
+            tmax: f64::INFINITY,
+            flags: 0,
+            weight: 1.0,
+            coef: DVec3::ONE,
+            depth: 0,
+            amb: 0,
+            src: None,
+            skip: None,
+            start: 0.0,
+        }
+    }
+
+    /// Radiance along a ray (`dir` need not be unit; a zero direction gives zero).
+    pub fn radiance(&self, ray_index: u64, org: DVec3, dir: DVec3) -> [f64; 3] {
+        let mut cx = Ctx {
+            rng: Rng::for_ray(self.opts.seed, ray_index),
+            tracked: &[],
+            sink: None,
+        };
+        let d = dir.normalize_or_zero();
+        if d == DVec3::ZERO {
+            return [0.0; 3];
+        }
+        self.trace(&Self::primary(org, d), &mut cx).to_array()
+    }
+
+    /// Irradiance at `point` on a surface facing `normal` (rtrace `-I`).
+    pub fn irradiance(&self, ray_index: u64, point: DVec3, normal: DVec3) -> [f64; 3] {
+        let mut cx = Ctx {
+            rng: Rng::for_ray(self.opts.seed, ray_index),
+            tracked: &[],
+            sink: None,
+        };
+        let n = normal.normalize_or_zero();
+        if n == DVec3::ZERO {
+            return [0.0; 3];
+        }
+        self.irradiance_in(point, n, &mut cx).to_array()
+    }
+
+    /// Traces a ray and reports every ray that reaches a surface whose direct modifier
+    /// is tracked (`tracked[scene prim index]`), as rcontrib does; returns the radiance.
+    pub fn contributions(
+        &self,
+        ray_index: u64,
+        org: DVec3,
+        dir: DVec3,
+        tracked: &[bool],
+        sink: &mut impl FnMut(Contribution),
+    ) -> [f64; 3] {
+        let d = dir.normalize_or_zero();
+        if d == DVec3::ZERO {
+            return [0.0; 3];
+        }
+        let mut cx = Ctx {
+            rng: Rng::for_ray(self.opts.seed, ray_index),
+            tracked,
+            sink: Some(sink),
+        };
+        self.trace(&Self::primary(org, d), &mut cx).to_array()
+    }
+
+    /// As [`contributions`](Self::contributions) for an irradiance request (`-I+`):
+    /// `point` and `normal` as in [`irradiance`](Self::irradiance).
+    pub fn contributions_irradiance(
+        &self,
+        ray_index: u64,
+        point: DVec3,
+        normal: DVec3,
+        tracked: &[bool],
+        sink: &mut impl FnMut(Contribution),
+    ) -> [f64; 3] {
+        let n = normal.normalize_or_zero();
+        if n == DVec3::ZERO {
+            return [0.0; 3];
+        }
+        let mut cx = Ctx {
+            rng: Rng::for_ray(self.opts.seed, ray_index),
+            tracked,
+            sink: Some(sink),
+        };
+        self.irradiance_in(point, n, &mut cx).to_array()
+    }
+
+    fn irradiance_in(&self, p: DVec3, n: DVec3, cx: &mut Ctx) -> DVec3 {
+        // Radiance's -I: a Lambertian of reflectance pi at the point, seen along -n.
+        let r = Ray {
+            org: p + n * 1.1e-4,
+            dir: -n,
+            ..Self::primary(p, -n)
+        };
+        let rho = DVec3::splat(PI);
+        let mut val = self.direct(&r, p, n, None, cx, |_l, omega, ldot| {
+            if ldot > 0.0 {
+                rho * (ldot * omega / PI)
+            } else {
+                DVec3::ZERO
+            }
+        });
+        val += self.ambient(&r, p, n, rho, None, cx);
+        val
+    }
+
+    fn tmin(p: DVec3) -> f64 {
+        1e-9 * (1.0 + p.abs().max_element())
+    }
+
+    /// Russian roulette and weight limits (Radiance's `rayorigin`); may scale `rcoef`.
+    fn admit(&self, child: &mut Ray, rcoef: &mut DVec3, cx: &mut Ctx) -> bool {
+        if child.weight <= 0.0 {
+            return false;
+        }
+        let lr = self.opts.lr;
+        let lw = self.opts.lw;
+        if lr <= 0 {
+            if lr < 0 && child.depth > -lr {
+                return false;
+            }
+            if child.weight >= lw {
+                return true;
+            }
+            if lw <= 0.0 {
+                return true;
+            }
+            if cx.rng.next_f64() > child.weight / lw {
+                return false;
+            }
+            let s = lw / child.weight;
+            *rcoef *= s;
+            child.coef *= s;
+            child.weight = lw;
+            true
+        } else {
+            child.depth <= lr && child.weight >= lw
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn child(
+        &self,
+        r: &Ray,
+        org: DVec3,
+        dir: DVec3,
+        flag: u8,
+        rcoef: DVec3,
+        skip: Option<usize>,
+        dist: f64,
+    ) -> Ray {
+        Ray {
+            org,
+            dir,
+            tmax: f64::INFINITY,
+            flags: r.flags | flag,
+            weight: r.weight * maxc(rcoef),
+            coef: r.coef * rcoef,
+            depth: r.depth + 1,
+            amb: r.amb,
+            src: if flag == TRANS { r.src } else { None },
+            skip,
+            start: r.start + dist,
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn report(
+        &self,
+        cx: &mut Ctx,
+        r: &Ray,
+        prim: usize,
+        rcol: DVec3,
+        hit: DVec3,
+        normal: DVec3,
+        dist: f64,
+        zeroed: bool,
+    ) {
+        let Some(sink) = cx.sink.as_mut() else { return };
+        let Some(m) = self.modifier_of[prim] else {
+            return;
+        };
+        if !cx.tracked.get(m).copied().unwrap_or(false) || zeroed {
+            return;
+        }
+        if let Some(s) = r.src {
+            if self.sources[s].prim != prim {
+                return;
+            }
+        }
+        if maxc(r.coef) <= 1e-6 {
+            return;
+        }
+        sink(Contribution {
+            modifier: m,
+            coef: r.coef.to_array(),
+            value: (r.coef * rcol).to_array(),
+            org: r.org,
+            dir: r.dir,
+            hit,
+            normal,
+            total_dist: r.start + dist,
+            dist,
+        });
+    }
+
+    fn trace(&self, r: &Ray, cx: &mut Ctx) -> DVec3 {
+        let tmin = Self::tmin(r.org);
+        match self.accel.closest(r.org, r.dir, tmin, r.tmax, r.skip) {
+            None => {
+                if r.tmax.is_finite() {
+                    return DVec3::ZERO;
+                }
+                let k = match r.src {
+                    Some(s) => match self.sources[s].geom {
+                        SourceGeom::Distant(k) => Some(k),
+                        SourceGeom::Local(_) => None,
+                    },
+                    None => self.find_distant(r.dir),
+                };
+                let Some(k) = k else { return DVec3::ZERO };
+                let d = &self.distant[k];
+                let (val, zeroed) =
+                    self.shade_light(r, d.mat, 1.0, f64::INFINITY, DVec3::ZERO, None, cx);
+                self.report(cx, r, d.prim, val, r.org, -r.dir, 1e10, zeroed);
+                val
+            }
+            Some(h) => {
+                let p = r.org + r.dir * h.t;
+                let n = self.accel.shapes[h.shape].normal(p);
+                let m = self.surf_mat[h.shape];
+                let (val, zeroed) = self.shade(r, m, h.shape, p, n, h.t, cx);
+                self.report(cx, r, self.surf_prim[h.shape], val, p, n, h.t, zeroed);
+                val
+            }
+        }
+    }
+
+    fn find_distant(&self, dir: DVec3) -> Option<usize> {
+        let within = |d: &Distant| dir.dot(d.dir) >= d.cos_half - 1e-12;
+        self.distant
+            .iter()
+            .position(|d| !d.glow && within(d))
+            .or_else(|| self.distant.iter().position(within))
+    }
+
+    /// Continues a ray straight through the surface it hit.
+    fn pass(&self, r: &Ray, shape: usize, p: DVec3, t: f64, cx: &mut Ctx) -> DVec3 {
+        let flat = self.accel.shapes[shape].is_flat();
+        let mut c = r.clone();
+        c.org = p;
+        c.skip = flat.then_some(shape);
+        c.start += t;
+        if c.tmax.is_finite() {
+            c.tmax -= t;
+        }
+        self.trace(&c, cx)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn shade(
+        &self,
+        r: &Ray,
+        m: usize,
+        shape: usize,
+        p: DVec3,
+        n: DVec3,
+        t: f64,
+        cx: &mut Ctx,
+    ) -> (DVec3, bool) {
+        let rod = -r.dir.dot(n);
+        match &self.mats[&m] {
+            Material::Light { .. } => self.shade_light(r, m, rod, t, p, Some(shape), cx),
+            Material::Glass { tn, n: idx } => (
+                self.shade_glass(r, *tn, *idx, shape, p, n, rod, t, cx),
+                false,
+            ),
+            Material::Mirror { color } => {
+                if r.flags & SHADOW != 0 {
+                    return (DVec3::ZERO, false);
+                }
+                let nrm = if rod < 0.0 { -n } else { n };
+                let pdot = rod.abs();
+                let dir = (r.dir + nrm * (2.0 * pdot)).normalize();
+                (
+                    self.spawn(r, p, dir, REFLECTED, *color, shape, t, cx),
+                    false,
+                )
+            }
+            Material::Normal {
+                color,
+                spec,
+                rough,
+                trans,
+                tspec,
+                metal,
+            } => (
+                self.shade_normal(
+                    r, *color, *spec, *rough, *trans, *tspec, *metal, shape, p, n, rod, t, cx,
+                ),
+                false,
+            ),
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn spawn(
+        &self,
+        r: &Ray,
+        p: DVec3,
+        dir: DVec3,
+        flag: u8,
+        rcoef: DVec3,
+        shape: usize,
+        t: f64,
+        cx: &mut Ctx,
+    ) -> DVec3 {
+        let mut rc = rcoef;
+        let skip = self.accel.shapes[shape].is_flat().then_some(shape);
+        let mut c = self.child(r, p, dir, flag, rc, skip, t);
+        if !self.admit(&mut c, &mut rc, cx) {
+            return DVec3::ZERO;
+        }
+        rc * self.trace(&c, cx)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn shade_light(
+        &self,
+        r: &Ray,
+        m: usize,
+        rod: f64,
+        t: f64,
+        p: DVec3,
+        shape: Option<usize>,
+        cx: &mut Ctx,
+    ) -> (DVec3, bool) {
+        let Material::Light { color, kind } = &self.mats[&m] else {
+            return (DVec3::ZERO, false);
+        };
+        let distglow = matches!(kind, LightKind::Glow(rad) if *rad >= -FTINY && t > *rad);
+        if r.flags & (AMBIENT | SPECULAR) != 0 && !(r.flags & SHADOW != 0 || rod < 0.0 || distglow)
+        {
+            return (DVec3::ZERO, true);
+        }
+        if let Some(s) = r.src {
+            if self.sources[s].mat != m {
+                return (DVec3::ZERO, true);
+            }
+        }
+        if let LightKind::Illum(alt) = kind {
+            if r.src.is_none() {
+                if let Some(shape) = shape {
+                    return match alt {
+                        Some(a) => {
+                            let n = self.accel.shapes[shape].normal(p);
+                            self.shade(r, *a, shape, p, n, t, cx)
+                        }
+                        None => (self.pass(r, shape, p, t, cx), false),
+                    };
+                }
+            }
+        }
+        if rod < 0.0 {
+            return (DVec3::ZERO, false);
+        }
+        if let LightKind::Spot(cosang, aim) = kind {
+            if (-r.dir).dot(*aim) < *cosang {
+                return (DVec3::ZERO, false);
+            }
+        }
+        (*color, false)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn shade_glass(
+        &self,
+        r: &Ray,
+        tn: DVec3,
+        idx: f64,
+        shape: usize,
+        p: DVec3,
+        n: DVec3,
+        rod: f64,
+        t: f64,
+        cx: &mut Ctx,
+    ) -> DVec3 {
+        let pdot = rod.abs().max(1e-3);
+        let nrm = if rod < 0.0 { -n } else { n };
+        let cos2 = ((1.0 - 1.0 / (idx * idx)) + pdot * pdot / (idx * idx)).sqrt();
+        let r1e = ((pdot - idx * cos2) / (pdot + idx * cos2)).powi(2);
+        let r1m = ((1.0 / pdot - idx / cos2) / (1.0 / pdot + idx / cos2)).powi(2);
+        let mut trans = DVec3::ZERO;
+        let mut refl = DVec3::ZERO;
+        for c in 0..3 {
+            let tau = tn[c].max(1e-15).powf(1.0 / cos2);
+            let t2 = tau * tau;
+            trans[c] = 0.5 * (1.0 - r1e).powi(2) * tau / (1.0 - r1e * r1e * t2)
+                + 0.5 * (1.0 - r1m).powi(2) * tau / (1.0 - r1m * r1m * t2);
+            refl[c] = 0.5 * r1e * (1.0 + (1.0 - 2.0 * r1e) * t2) / (1.0 - r1e * r1e * t2)
+                + 0.5 * r1m * (1.0 + (1.0 - 2.0 * r1m) * t2) / (1.0 - r1m * r1m * t2);
+        }
+        let mut val = DVec3::ZERO;
+        if maxc(trans) > FTINY {
+            val += self.spawn(r, p, r.dir, TRANS, trans, shape, t, cx);
+        }
+        if r.flags & SHADOW == 0 && maxc(refl) > FTINY {
+            let dir = (r.dir + nrm * (2.0 * pdot)).normalize();
+            val += self.spawn(r, p, dir, REFLECTED, refl, shape, t, cx);
+        }
+        val
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn shade_normal(
+        &self,
+        r: &Ray,
+        color: DVec3,
+        spec: f64,
+        rough: f64,
+        trans: f64,
+        tspec_frac: f64,
+        metal: bool,
+        shape: usize,
+        p: DVec3,
+        n: DVec3,
+        rod: f64,
+        t: f64,
+        cx: &mut Ctx,
+    ) -> DVec3 {
+        let nrm = if rod < 0.0 { -n } else { n };
+        let pdot = rod.abs().max(1e-3);
+        let alpha2 = rough * rough;
+        let pure = alpha2 <= FTINY;
+        let fres = |c: f64| (-5.85 * c).exp() - 0.00287989916;
+        let mut rspec = spec;
+        let use_fres = pure && spec >= 0.017999;
+        if use_fres {
+            rspec = spec + fres(pdot) * (1.0 - spec);
+        }
+        let tt = trans * (1.0 - rspec);
+        let tspec = tt * tspec_frac;
+        let tdiff = tt - tspec;
+        let rdiff = 1.0 - tt - rspec;
+        let scolor = if metal {
+            if use_fres {
+                let f = fres(pdot);
+                DVec3::splat(f) + color * spec * (1.0 - f)
+            } else {
+                color * rspec
+            }
+        } else {
+            DVec3::splat(rspec)
+        };
+        if r.flags & SHADOW != 0 {
+            if tspec > FTINY && pure {
+                return self.spawn(r, p, r.dir, TRANS, color * tspec, shape, t, cx);
+            }
+            return DVec3::ZERO;
+        }
+        let flat = self.accel.shapes[shape].is_flat();
+        let d = r.dir;
+        let mut val = self.direct(r, p, nrm, Some(shape), cx, |l, omega, ldot| {
+            let mut c = DVec3::ZERO;
+            if ldot > 0.0 {
+                let mut dr = rdiff;
+                if use_fres {
+                    dr *= 1.0 - fres(ldot.abs());
+                }
+                c += color * (dr * ldot * omega / PI);
+                if rspec > FTINY && !pure {
+                    let h = l - d;
+                    let mut a2 = alpha2;
+                    if flat {
+                        a2 += omega / (4.0 * PI);
+                    }
+                    let hn = h.dot(nrm);
+                    if hn > 0.0 {
+                        let hh = h.dot(h);
+                        let tt = (hh - hn * hn) / (hn * hn);
+                        let f = (-tt / a2).exp() * hh / (PI * hn.powi(4) * a2);
+                        c += scolor * (f * ldot * omega);
+                    }
+                }
+            } else if ldot < 0.0 && tdiff > FTINY {
+                c += color * (tdiff * -ldot * omega / PI);
+            }
+            c
+        });
+        if self.effects.specular {
+            if rspec > FTINY && pure {
+                let dir = (d + nrm * (2.0 * pdot)).normalize();
+                val += self.spawn(r, p, dir, REFLECTED, scolor, shape, t, cx);
+            } else if rspec > FTINY && self.opts.ss > 0.0 && rspec > self.opts.st {
+                // one Ward-lobe sample (isotropic)
+                let (u, v) = (cx.rng.next_f64(), cx.rng.next_f64());
+                let tan2 = -alpha2 * (1.0 - u).max(1e-300).ln();
+                let ct = 1.0 / (1.0 + tan2).sqrt();
+                let st = (1.0 - ct * ct).max(0.0).sqrt();
+                let (a, b) = frame(nrm);
+                let phi = 2.0 * PI * v;
+                let h = a * (st * phi.cos()) + b * (st * phi.sin()) + nrm * ct;
+                let dir = d - h * (2.0 * d.dot(h));
+                if dir.dot(nrm) > 0.0 {
+                    val += self.spawn(
+                        r,
+                        p,
+                        dir.normalize(),
+                        SPECULAR | REFLECTED,
+                        scolor,
+                        shape,
+                        t,
+                        cx,
+                    );
+                }
+            }
+            if tspec > FTINY && pure {
+                val += self.spawn(r, p, d, TRANS, color * tspec, shape, t, cx);
+            }
+        }
+        if rdiff > FTINY {
+            val += self.ambient(r, p, nrm, color * rdiff, Some(shape), cx);
+        }
+        if tdiff > FTINY {
+            val += self.ambient(r, p, -nrm, color * tdiff, Some(shape), cx);
+        }
+        val
+    }
+
+    /// Direct lighting at `p` (normal `nrm`): `bsdf(l, omega, ldot)` gives the coefficient
+    /// of a source sample; a shadow ray fetches the source's radiance.
+    fn direct(
+        &self,
+        r: &Ray,
+        p: DVec3,
+        nrm: DVec3,
+        shape: Option<usize>,
+        cx: &mut Ctx,
+        bsdf: impl Fn(DVec3, f64, f64) -> DVec3,
+    ) -> DVec3 {
+        let mut val = DVec3::ZERO;
+        if !self.effects.direct {
+            return val;
+        }
+        let skip = shape.filter(|&s| self.accel.shapes[s].is_flat());
+        for (si, s) in self.sources.iter().enumerate() {
+            match s.geom {
+                SourceGeom::Distant(k) => {
+                    let d = &self.distant[k];
+                    let mut l = d.dir;
+                    if self.opts.dj > 0.0 {
+                        // jitter within the cone
+                        let (u, v) = (cx.rng.next_f64(), cx.rng.next_f64());
+                        let ct = 1.0 - self.opts.dj * u * (1.0 - d.cos_half);
+                        let st = (1.0 - ct * ct).max(0.0).sqrt();
+                        let (a, b) = frame(d.dir);
+                        let ph = 2.0 * PI * v;
+                        l = (a * (st * ph.cos()) + b * (st * ph.sin()) + d.dir * ct).normalize();
+                    }
+                    let ldot = l.dot(nrm);
+                    self.shadow(
+                        r,
+                        p,
+                        l,
+                        f64::INFINITY,
+                        si,
+                        skip,
+                        bsdf(l, d.omega, ldot),
+                        &mut val,
+                        cx,
+                    );
+                }
+                SourceGeom::Local(sh) => {
+                    if Some(sh) == shape {
+                        continue;
+                    }
+                    let maxrad = match &self.mats[&s.mat] {
+                        Material::Light {
+                            kind: LightKind::Glow(rad),
+                            ..
+                        } => *rad,
+                        _ => f64::INFINITY,
+                    };
+                    let samples = self.source_samples(sh, p, cx);
+                    for (q, omega) in samples {
+                        let v = q - p;
+                        let dist = v.length();
+                        if dist <= 0.0 || dist > maxrad || omega <= 0.0 {
+                            continue;
+                        }
+                        let l = v / dist;
+                        let ldot = l.dot(nrm);
+                        self.shadow(
+                            r,
+                            p,
+                            l,
+                            dist * (1.0 + 1e-7) + Self::tmin(q),
+                            si,
+                            skip,
+                            bsdf(l, omega, ldot),
+                            &mut val,
+                            cx,
+                        );
+                    }
+                }
+            }
+        }
+        val
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn shadow(
+        &self,
+        r: &Ray,
+        p: DVec3,
+        l: DVec3,
+        tmax: f64,
+        si: usize,
+        skip: Option<usize>,
+        coef: DVec3,
+        val: &mut DVec3,
+        cx: &mut Ctx,
+    ) {
+        if maxc(coef) <= FTINY {
+            return;
+        }
+        let mut rc = coef;
+        let mut c = self.child(r, p, l, SHADOW, rc, skip, 0.0);
+        c.src = Some(si);
+        c.tmax = tmax;
+        if !self.admit(&mut c, &mut rc, cx) {
+            return;
+        }
+        *val += rc * self.trace(&c, cx);
+    }
+
+    /// Sample points on a local source seen from `p`, with the solid angle each stands for.
+    fn source_samples(&self, sh: usize, p: DVec3, cx: &mut Ctx) -> Vec<(DVec3, f64)> {
+        let shape = &self.accel.shapes[sh];
+        let dj = self.opts.dj;
+        let jit = |cx: &mut Ctx| {
+            if dj > 0.0 {
+                0.5 + dj * (cx.rng.next_f64() - 0.5)
+            } else {
+                0.5
+            }
+        };
+        match shape {
+            Shape::Sphere { c, r, .. } => {
+                let d2 = (*c - p).length_squared();
+                if d2 <= r * r {
+                    return vec![];
+                }
+                let omega = 2.0 * PI * (1.0 - (1.0 - r * r / d2).max(0.0).sqrt());
+                vec![(*c, omega)]
+            }
+            Shape::Ring { c, n, r0, r1 } => {
+                let size = 2.0 * r1;
+                let k = self.divisions(size, (*c - p).length());
+                let (a, b) = frame(*n);
+                let mut out = Vec::new();
+                let area = PI * (r1 * r1 - r0 * r0);
+                let nn = (k * k) as f64;
+                for i in 0..k {
+                    for j in 0..k {
+                        let u = (i as f64 + jit(cx)) / k as f64;
+                        let v = (j as f64 + jit(cx)) / k as f64;
+                        let rad = (r0 * r0 + u * (r1 * r1 - r0 * r0)).sqrt();
+                        let ph = 2.0 * PI * v;
+                        let q = *c + a * (rad * ph.cos()) + b * (rad * ph.sin());
+                        let w = q - p;
+                        let d2 = w.length_squared();
+                        let cs = (w.dot(*n) / d2.sqrt()).abs();
+                        out.push((q, area * cs / (nn * d2)));
+                    }
+                }
+                out
+            }
+            Shape::Polygon(poly) => {
+                let cen = poly.centroid();
+                let dist = (cen - p).length();
+                let size = poly.area.sqrt();
+                let k = self.divisions(size, dist);
+                let nn = k * k;
+                // fan triangles from the first vertex, area-weighted
+                let v = &poly.verts;
+                let mut cum = Vec::with_capacity(v.len());
+                let mut tot = 0.0;
+                for i in 1..v.len() - 1 {
+                    tot += 0.5 * (v[i] - v[0]).cross(v[i + 1] - v[0]).dot(poly.normal).abs();
+                    cum.push(tot);
+                }
+                let mut out = Vec::with_capacity(nn);
+                for i in 0..k {
+                    for j in 0..k {
+                        let q = if nn == 1 && dj == 0.0 {
+                            cen
+                        } else {
+                            let u = (i as f64 + jit(cx)) / k as f64;
+                            let w = (j as f64 + jit(cx)) / k as f64;
+                            let x = u * tot;
+                            let ti = cum.iter().position(|&c| x <= c).unwrap_or(cum.len() - 1);
+                            let lo = if ti == 0 { 0.0 } else { cum[ti - 1] };
+                            let f = ((x - lo) / (cum[ti] - lo).max(1e-300)).clamp(0.0, 1.0);
+                            let su = f.sqrt();
+                            let (b0, b1) = (1.0 - su, su * (1.0 - w));
+                            v[0] * b0 + v[ti + 1] * b1 + v[ti + 2] * (1.0 - b0 - b1)
+                        };
+                        let wv = q - p;
+                        let d2 = wv.length_squared();
+                        let cs = (wv.dot(poly.normal) / d2.sqrt()).abs();
+                        out.push((q, poly.area * cs / (nn as f64 * d2)));
+                    }
+                }
+                out
+            }
+            Shape::Cone { .. } => vec![],
+        }
+    }
+
+    fn divisions(&self, size: f64, dist: f64) -> usize {
+        if self.opts.ds <= 0.0 || dist <= 0.0 {
+            return 1;
+        }
+        ((size / dist / self.opts.ds).ceil() as usize).clamp(1, 16)
+    }
+
+    /// Indirect diffuse light by stratified cosine-weighted hemisphere sampling (`-aa 0`),
+    /// multiplied by `rcol` (the surface's diffuse colour × reflectance).
+    fn ambient(
+        &self,
+        r: &Ray,
+        p: DVec3,
+        nrm: DVec3,
+        rcol: DVec3,
+        shape: Option<usize>,
+        cx: &mut Ctx,
+    ) -> DVec3 {
+        if !self.effects.ambient || r.amb >= self.opts.ab {
+            return rcol * DVec3::from_array(self.opts.av);
+        }
+        let mut wt = r.weight;
+        let d = 0.8 * maxc(rcol) * r.weight / (self.opts.ad as f64 * self.opts.lw);
+        if wt > d {
+            wt = d;
+        }
+        let n = (((self.opts.ad as f64 * wt).sqrt() + 0.5) as usize).max(1);
+        let acoef = rcol / (n * n) as f64;
+        let (a, b) = frame(nrm);
+        let skip = shape.filter(|&s| self.accel.shapes[s].is_flat());
+        let mut sum = DVec3::ZERO;
+        for i in 0..n {
+            for j in 0..n {
+                let x = (j as f64 + cx.rng.next_f64()) / n as f64;
+                let y = (i as f64 + cx.rng.next_f64()) / n as f64;
+                let (u, v) = square_to_disk(x, y);
+                let z = (1.0 - u * u - v * v).max(0.0).sqrt();
+                let dir = (a * u + b * v + nrm * z).normalize();
+                let mut rc = acoef;
+                let mut c = self.child(r, p, dir, AMBIENT, rc, skip, 0.0);
+                c.amb = r.amb + 1;
+                if !self.admit(&mut c, &mut rc, cx) {
+                    continue;
+                }
+                sum += rc * self.trace(&c, cx);
+            }
+        }
+        sum
+    }
+}
+
+/// Shirley–Chiu concentric map of the unit square onto the unit disk.
+fn square_to_disk(x: f64, y: f64) -> (f64, f64) {
+    let (a, b) = (2.0 * x - 1.0, 2.0 * y - 1.0);
+    if a == 0.0 && b == 0.0 {
+        return (0.0, 0.0);
+    }
+    let (r, phi) = if a * a > b * b {
+        (a, (PI / 4.0) * (b / a))
+    } else {
+        (b, PI / 2.0 - (PI / 4.0) * (a / b))
+    };
+    (r * phi.cos(), r * phi.sin())
+}
+
+/// Two unit vectors completing `n` to an orthonormal frame.
+fn frame(n: DVec3) -> (DVec3, DVec3) {
+    let a = n.any_orthonormal_vector();
+    (a, n.cross(a))
+}
