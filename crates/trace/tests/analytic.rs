@@ -60,8 +60,7 @@ fn interreflection_inside_a_diffuse_sphere() {
         ..TraceOptions::rtrace()
     };
     let t = Tracer::new(&s, &opts).unwrap();
-    let omega =
-        2.0 * std::f64::consts::PI * (1.0 - (1.0 - (r0 / big_r) * (r0 / big_r)).sqrt());
+    let omega = 2.0 * std::f64::consts::PI * (1.0 - (1.0 - (r0 / big_r) * (r0 / big_r)).sqrt());
     let e0 = ls * omega;
     let want = rho * e0 / (std::f64::consts::PI * (1.0 - rho));
     let n = 200;
