@@ -47,7 +47,7 @@ fn distant_source_irradiance_is_l_omega_cos() {
 fn interreflection_inside_a_diffuse_sphere() {
     // bubble of radius R, reflectance rho, small spherical light at the centre:
     // direct irradiance on the wall E0 = Ls * omega is uniform, so L = rho E0 / (pi (1 - rho)).
-    let (big_r, r0, ls, rho) = (2.0, 0.01, 1.0e4, 0.5);
+    let (big_r, r0, ls, rho): (f64, f64, f64, f64) = (2.0, 0.01, 1.0e4, 0.5);
     let text = format!(
         "void plastic wall 0 0 5 {rho} {rho} {rho} 0 0\nwall bubble room 0 0 4 0 0 0 {big_r}\n\
          void light lamp 0 0 3 {ls} {ls} {ls}\nlamp sphere bulb 0 0 4 0 0 0 {r0}\n"
