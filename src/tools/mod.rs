@@ -7,6 +7,7 @@ pub mod gendaylit;
 pub mod gendaymtx;
 pub mod gensky;
 pub mod genskyvec;
+pub mod rtrace;
 pub mod view_opts;
 pub mod vwrays;
 
@@ -19,6 +20,7 @@ pub fn registry() -> &'static [(&'static str, Run)] {
         ("gendaymtx", gendaymtx::run),
         ("gensky", gensky::run),
         ("genskyvec", genskyvec::run),
+        ("rtrace", rtrace::run),
         ("vwrays", vwrays::run),
     ]
 }

@@ -1185,3 +1185,84 @@ fn frame(n: DVec3) -> (DVec3, DVec3) {
     let a = n.any_orthonormal_vector();
     (a, n.cross(a))
 }
+
+/// What a ray hits first (rtrace `-ol -op -on`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FirstHit {
+    /// Distance (1e10 for a distant source or nothing).
+    pub t: f64,
+    /// Hit point (the origin when nothing was hit).
+    pub point: DVec3,
+    /// Surface normal as stored on the ray: geometric normal, flipped for materials that
+    /// face the ray (plastic, metal, trans, glass, mirror), as Radiance reports it.
+    pub normal: DVec3,
+    /// Scene index of the surface, if any.
+    pub prim: Option<usize>,
+}
+
+impl Tracer {
+    /// The first surface along a ray.
+    pub fn first_hit(&self, org: DVec3, dir: DVec3) -> FirstHit {
+        let d = dir.normalize_or_zero();
+        match self
+            .accel
+            .closest(org, d, Self::tmin(org), f64::INFINITY, None)
+        {
+            Some(h) => {
+                let p = org + d * h.t;
+                let mut n = self.accel.shapes[h.shape].normal(p);
+                if !self.mats[&self.surf_mat[h.shape]].is_light() && n.dot(d) > 0.0 {
+                    n = -n;
+                }
+                FirstHit {
+                    t: h.t,
+                    point: p,
+                    normal: n,
+                    prim: Some(self.surf_prim[h.shape]),
+                }
+            }
+            None => FirstHit {
+                t: 1e10,
+                point: org,
+                normal: -d,
+                prim: None,
+            },
+        }
+    }
+
+    /// Irradiance at the first opaque surface along a ray (rtrace `-i`): glass, illum and
+    /// straight-transmitting surfaces are passed; an emitter or the sky gives its radiance.
+    pub fn irradiance_at_hit(&self, ray_index: u64, org: DVec3, dir: DVec3) -> [f64; 3] {
+        let d = dir.normalize_or_zero();
+        if d == DVec3::ZERO {
+            return [0.0; 3];
+        }
+        let mut o = org;
+        let mut skip = None;
+        for _ in 0..100 {
+            let Some(h) = self.accel.closest(o, d, Self::tmin(o), f64::INFINITY, skip) else {
+                return self.radiance(ray_index, o, d);
+            };
+            let p = o + d * h.t;
+            let mut n = self.accel.shapes[h.shape].normal(p);
+            match &self.mats[&self.surf_mat[h.shape]] {
+                Material::Glass { .. }
+                | Material::Light {
+                    kind: LightKind::Illum(_),
+                    ..
+                } => {
+                    o = p;
+                    skip = self.accel.shapes[h.shape].is_flat().then_some(h.shape);
+                }
+                Material::Light { .. } => return self.radiance(ray_index, o, d),
+                _ => {
+                    if n.dot(d) > 0.0 {
+                        n = -n;
+                    }
+                    return self.irradiance(ray_index, p, n);
+                }
+            }
+        }
+        [0.0; 3]
+    }
+}

@@ -1,0 +1,316 @@
+//! rtrace: trace rays (or compute irradiance at points) in a scene.
+
+use std::io::{BufRead, Read, Write};
+use std::process::ExitCode;
+
+use anyhow::{bail, Context, Result};
+use fenestra_trace::{DVec3, TraceOptions, Tracer};
+use rayon::prelude::*;
+
+const USAGE: &str = "[-I|-i][-o{o,d,v,w,l,L,p,n,N}][-f{a,f,d}{a,f,d}][-h][-x N][-y N][-n N][-ab N][-ad N][-aa V][-ar N][-as N][-av r g b][-lw W][-lr N][-ds V][-dj V][-dc V][-dr N][-dt V][-st V][-ss V][-bv][-u][-v] scene.{rad,oct}…";
+
+#[derive(Clone, Copy, PartialEq)]
+enum Fmt {
+    Ascii,
+    Float,
+    Double,
+}
+
+fn fmt_of(c: char) -> Result<Fmt> {
+    Ok(match c {
+        'a' => Fmt::Ascii,
+        'f' => Fmt::Float,
+        'd' => Fmt::Double,
+        _ => bail!("unsupported data format '{c}' (fenestra supports a, f, d)"),
+    })
+}
+
+fn num(args: &[String], i: usize) -> Result<f64> {
+    let w = args
+        .get(i)
+        .with_context(|| format!("option {} needs a value", args[i - 1]))?;
+    fenestra_cli::opts::parse_real(w)
+        .with_context(|| format!("option {}: '{w}' is not a number", args[i - 1]))
+}
+
+fn toggle(a: &str, name: &str, cur: bool) -> Option<bool> {
+    let rest = a.get(1..)?.strip_prefix(name)?;
+    let plus = a.starts_with('+');
+    match rest {
+        "" => Some(if plus { true } else { !cur }),
+        "+" | "y" | "1" => Some(true),
+        "-" | "n" | "0" => Some(false),
+        _ => None,
+    }
+}
+
+/// Runs rtrace.
+pub fn run(args: Vec<String>) -> Result<ExitCode> {
+    if args.iter().skip(1).any(|a| a == "--help") {
+        println!("{} {USAGE}\nTraces rays read from standard input (origin, direction) and prints values.", fenestra_cli::prog());
+        return Ok(ExitCode::SUCCESS);
+    }
+    let mut o = TraceOptions::rtrace();
+    let (mut irr, mut irr_hit, mut header, mut verbose) = (false, false, true, false);
+    let mut outspec = "v".to_string();
+    let (mut fin, mut fout) = (Fmt::Ascii, Fmt::Ascii);
+    let (mut xres, mut yres, mut nproc) = (0usize, 0usize, 1usize);
+    let mut aa = 0.1;
+    let mut files = Vec::new();
+    let mut i = 1;
+    while i < args.len() {
+        let a = args[i].as_str();
+        if !(a.starts_with('-') || a.starts_with('+')) || a == "-" {
+            files.extend(args[i..].iter().cloned());
+            break;
+        }
+        if let Some(v) = toggle(a, "I", irr) {
+            irr = v;
+        } else if let Some(v) = toggle(a, "i", irr_hit) {
+            irr_hit = v;
+        } else if let Some(v) = toggle(a, "h", header) {
+            header = v;
+        } else if let Some(v) = toggle(a, "bv", o.bv) {
+            o.bv = v;
+        } else if let Some(v) = toggle(a, "u", false) {
+            let _ = v;
+        } else if let Some(v) = toggle(a, "w", true) {
+            let _ = v;
+        } else if a == "-v" {
+            verbose = true;
+        } else if let Some(spec) = a.strip_prefix("-o") {
+            outspec = spec.to_string();
+        } else if let Some(f) = a
+            .strip_prefix("-f")
+            .filter(|f| !f.is_empty() && f.len() <= 2 && f.chars().all(|c| "afd".contains(c)))
+        {
+            let c: Vec<char> = f.chars().collect();
+            fin = fmt_of(c[0])?;
+            fout = fmt_of(*c.get(1).unwrap_or(&c[0]))?;
+        } else {
+            let name = &a[1..];
+            match name {
+                "ab" => o.ab = num(&args, i + 1)?.max(0.0) as u32,
+                "ad" => o.ad = num(&args, i + 1)?.max(1.0) as u32,
+                "lw" => o.lw = num(&args, i + 1)?,
+                "lr" => o.lr = num(&args, i + 1)? as i32,
+                "ds" => o.ds = num(&args, i + 1)?,
+                "dj" => o.dj = num(&args, i + 1)?,
+                "dc" => o.dc = num(&args, i + 1)?,
+                "dr" => o.dr = num(&args, i + 1)? as i32,
+                "dt" => o.dt = num(&args, i + 1)?,
+                "dp" => {}
+                "st" => o.st = num(&args, i + 1)?,
+                "ss" => o.ss = num(&args, i + 1)?,
+                "aa" => aa = num(&args, i + 1)?,
+                "ar" | "as" | "aw" => {
+                    num(&args, i + 1)?;
+                }
+                "af" | "ai" | "ae" | "aI" | "aE" => {
+                    args.get(i + 1).with_context(|| format!("option {a} needs a value"))?;
+                }
+                "x" => xres = num(&args, i + 1)?.max(0.0) as usize,
+                "y" => yres = num(&args, i + 1)?.max(0.0) as usize,
+                "n" => nproc = num(&args, i + 1)?.max(1.0) as usize,
+                "seed" => o.seed = num(&args, i + 1)? as u64,
+                "av" => {
+                    o.av = [num(&args, i + 1)?, num(&args, i + 2)?, num(&args, i + 3)?];
+                    i += 2;
+                }
+                "e" | "f" => bail!("option {a}: .cal patterns are not supported by this build of fenestra's rtrace"),
+                _ => bail!("unknown option '{a}'\nusage: {} {USAGE}", fenestra_cli::prog()),
+            }
+            i += 1;
+        }
+        i += 1;
+    }
+    if files.is_empty() {
+        bail!(
+            "missing scene file\nusage: {} {USAGE}",
+            fenestra_cli::prog()
+        );
+    }
+    if aa > 0.0 {
+        fenestra_cli::warn(format!("-aa {aa}: the irradiance cache is not supported; computing as with -aa 0 (pure Monte Carlo)"));
+    }
+    for c in outspec.chars() {
+        if !"odvVwlLpnN".contains(c) {
+            bail!("output specification -o{outspec}: '{c}' is not supported by fenestra (use o d v w l L p n N)");
+        }
+    }
+    let refs: Vec<&str> = files.iter().map(String::as_str).collect();
+    let scene = fenestra_scene::load(&refs)?;
+    let tracer = Tracer::new(&scene, &o)?;
+    for w in tracer.warnings() {
+        fenestra_cli::warn(w);
+    }
+    if verbose {
+        for n in &tracer.effects().notes {
+            eprintln!("{}: {n}", fenestra_cli::prog());
+        }
+    }
+    if tracer.source_count() == 0 && !outspec.chars().all(|c| "odlLpnN".contains(c)) {
+        fenestra_cli::warn("no light sources found");
+    }
+    let rays = read_rays(fin)?;
+    let expect = if yres > 0 { xres.max(1) * yres } else { 0 };
+    let out = std::io::stdout();
+    let mut w = std::io::BufWriter::with_capacity(1 << 16, out.lock());
+    if header {
+        let mut h = String::from("#?RADIANCE\n");
+        h.push_str(&fenestra_cli::command_line(&args));
+        h.push_str("\nSOFTWARE= fenestra\nNCOMP=3\n");
+        h.push_str(match fout {
+            Fmt::Ascii => "FORMAT=ascii\n",
+            Fmt::Float => "FORMAT=float\n",
+            Fmt::Double => "FORMAT=double\n",
+        });
+        h.push('\n');
+        if xres > 0 && yres > 0 {
+            h.push_str(&format!("-Y {yres} +X {xres}\n"));
+        }
+        w.write_all(h.as_bytes())?;
+    }
+    let n = if expect > 0 {
+        rays.len().min(expect)
+    } else {
+        rays.len()
+    };
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(nproc).build()?;
+    let progress = fenestra_cli::progress::Progress::new(n as u64, "rtrace");
+    let chunk = 1024;
+    for start in (0..n).step_by(chunk) {
+        let end = (start + chunk).min(n);
+        let vals: Vec<Vec<f64>> = pool.install(|| {
+            (start..end)
+                .into_par_iter()
+                .map(|k| {
+                    let (org, dir) = rays[k];
+                    let mut rec = Vec::new();
+                    let hit = if outspec.chars().any(|c| "lLpnN".contains(c)) {
+                        Some(tracer.first_hit(org, dir))
+                    } else {
+                        None
+                    };
+                    for c in outspec.chars() {
+                        match c {
+                            'o' => rec.extend(org.to_array()),
+                            'd' => rec.extend(dir.normalize_or_zero().to_array()),
+                            'v' | 'V' => {
+                                let v = if dir == DVec3::ZERO {
+                                    [0.0; 3]
+                                } else if irr {
+                                    tracer.irradiance(k as u64, org, dir)
+                                } else if irr_hit {
+                                    tracer.irradiance_at_hit(k as u64, org, dir)
+                                } else {
+                                    tracer.radiance(k as u64, org, dir)
+                                };
+                                rec.extend(v);
+                            }
+                            'w' => rec.push(1.0),
+                            'l' | 'L' => rec.push(hit.map_or(0.0, |h| h.t)),
+                            'p' => rec.extend(hit.map_or([0.0; 3], |h| h.point.to_array())),
+                            _ => rec.extend(hit.map_or([0.0; 3], |h| h.normal.to_array())),
+                        }
+                    }
+                    rec
+                })
+                .collect()
+        });
+        for rec in vals {
+            match fout {
+                Fmt::Ascii => {
+                    let mut s = String::new();
+                    for v in &rec {
+                        s.push_str(&format!("{}\t", fmt_e(*v)));
+                    }
+                    s.push('\n');
+                    w.write_all(s.as_bytes())?;
+                }
+                Fmt::Float => {
+                    for v in &rec {
+                        w.write_all(&(*v as f32).to_ne_bytes())?;
+                    }
+                }
+                Fmt::Double => {
+                    for v in &rec {
+                        w.write_all(&v.to_ne_bytes())?;
+                    }
+                }
+            }
+        }
+        progress.inc((end - start) as u64);
+    }
+    progress.finish();
+    w.flush()?;
+    if expect > 0 && rays.len() < expect {
+        bail!("unexpected EOF on input");
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// C's `%e` (6 digits after the point, exponent with sign and at least two digits).
+fn fmt_e(v: f64) -> String {
+    if !v.is_finite() {
+        return format!("{v}");
+    }
+    let s = format!("{v:.6e}");
+    let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
+    let e: i32 = e.parse().unwrap_or(0);
+    format!("{m}e{}{:02}", if e < 0 { '-' } else { '+' }, e.abs())
+}
+
+fn read_rays(fmt: Fmt) -> Result<Vec<(DVec3, DVec3)>> {
+    let stdin = std::io::stdin();
+    let mut rd = std::io::BufReader::with_capacity(1 << 16, stdin.lock());
+    let mut vals: Vec<f64> = Vec::new();
+    match fmt {
+        Fmt::Ascii => {
+            let mut line = String::new();
+            'outer: loop {
+                line.clear();
+                if rd.read_line(&mut line)? == 0 {
+                    break;
+                }
+                for wd in line.split_whitespace() {
+                    match fenestra_cli::opts::parse_real(wd) {
+                        Some(v) => vals.push(v),
+                        None => break 'outer,
+                    }
+                }
+            }
+        }
+        Fmt::Float | Fmt::Double => {
+            let mut bytes = Vec::new();
+            rd.read_to_end(&mut bytes)?;
+            if fmt == Fmt::Float {
+                vals.extend(
+                    bytes
+                        .chunks_exact(4)
+                        .map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]]) as f64),
+                );
+            } else {
+                vals.extend(
+                    bytes
+                        .chunks_exact(8)
+                        .map(|c| f64::from_ne_bytes(c.try_into().unwrap_or([0; 8]))),
+                );
+            }
+        }
+    }
+    Ok(vals
+        .chunks_exact(6)
+        .map(|c| (DVec3::new(c[0], c[1], c[2]), DVec3::new(c[3], c[4], c[5])))
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn c_style_exponent() {
+        assert_eq!(super::fmt_e(2.71828182), "2.718282e+00");
+        assert_eq!(super::fmt_e(1e10), "1.000000e+10");
+        assert_eq!(super::fmt_e(-2.5e-7), "-2.500000e-07");
+    }
+}
