@@ -309,7 +309,7 @@ fn read_rays(fmt: Fmt) -> Result<Vec<(DVec3, DVec3)>> {
 mod tests {
     #[test]
     fn c_style_exponent() {
-        assert_eq!(super::fmt_e(2.71828182), "2.718282e+00");
+        assert_eq!(super::fmt_e(1.23456789), "1.234568e+00");
         assert_eq!(super::fmt_e(1e10), "1.000000e+10");
         assert_eq!(super::fmt_e(-2.5e-7), "-2.500000e-07");
     }
