@@ -1021,14 +1021,13 @@ impl Tracer {
         if maxc(coef) <= FTINY {
             return;
         }
-        let mut rc = coef;
-        let mut c = self.child(r, p, l, SHADOW, rc, skip, 0.0);
+        // Radiance starts shadow rays without a coefficient: they keep the parent's
+        // weight and are never subject to Russian roulette.
+        let mut c = self.child(r, p, l, SHADOW, coef, skip, 0.0);
+        c.weight = r.weight;
         c.src = Some(si);
         c.tmax = tmax;
-        if !self.admit(&mut c, &mut rc, cx) {
-            return;
-        }
-        *val += rc * self.trace(&c, cx);
+        *val += coef * self.trace(&c, cx);
     }
 
     /// Sample points on a local source seen from `p`, with the solid angle each stands for.
