@@ -7,7 +7,7 @@ use anyhow::{bail, Context, Result};
 use fenestra_trace::{DVec3, TraceOptions, Tracer};
 use rayon::prelude::*;
 
-const USAGE: &str = "[-I|-i][-o{o,d,v,w,l,L,p,n,N}][-f{a,f,d}{a,f,d}][-h][-x N][-y N][-n N][-ab N][-ad N][-aa V][-ar N][-as N][-av r g b][-lw W][-lr N][-ds V][-dj V][-dc V][-dr N][-dt V][-st V][-ss V][-bv][-u][-v] scene.{rad,oct}…";
+const USAGE: &str = "[-I|-i][-o{o,d,v,w,l,L,p,n,N}][-f{a,f,d}{a,f,d}][-h][-x N][-y N][-n N][-ab N][-ad N][-aa V][-ar N][-as N][-av r g b][-lw W][-lr N][-ds V][-dj V][-dc V][-dr N][-dt V][-st V][-ss V][-bv][-u][-v][-full][-seed N] scene.{rad,oct}…";
 
 #[derive(Clone, Copy, PartialEq)]
 enum Fmt {
@@ -76,6 +76,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             let _ = v;
         } else if let Some(v) = toggle(a, "w", true) {
             let _ = v;
+        } else if a == "-full" {
+            o.full = true;
         } else if a == "-v" {
             verbose = true;
         } else if let Some(spec) = a.strip_prefix("-o") {
@@ -244,6 +246,13 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     }
     progress.finish();
     w.flush()?;
+    if verbose {
+        eprintln!(
+            "{}: {} rays traced for {n} input records",
+            fenestra_cli::prog(),
+            tracer.rays_traced()
+        );
+    }
     if expect > 0 && rays.len() < expect {
         bail!("unexpected EOF on input");
     }

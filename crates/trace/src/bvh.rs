@@ -174,6 +174,42 @@ impl Accel {
         best
     }
 
+    /// Whether anything lies in (tmin, tmax) along a unit direction, skipping `skip`
+    /// (stops at the first surface found).
+    pub fn occluded(
+        &self,
+        org: DVec3,
+        dir: DVec3,
+        tmin: f64,
+        tmax: f64,
+        skip: Option<usize>,
+    ) -> bool {
+        let test =
+            |i: usize| Some(i) != skip && self.shapes[i].intersect(org, dir, tmin, tmax).is_some();
+        match &self.bvh {
+            None => (0..self.shapes.len()).any(test),
+            Some(bvh) => {
+                let ray = Ray::new(
+                    Vec3A::new(org.x as f32, org.y as f32, org.z as f32),
+                    Vec3A::new(dir.x as f32 + 0.0, dir.y as f32 + 0.0, dir.z as f32 + 0.0),
+                    0.0,
+                    if tmax.is_finite() {
+                        up(tmax * (1.0 + 1e-6) + 4e-6 * self.scale)
+                    } else {
+                        f32::INFINITY
+                    },
+                );
+                !bvh.ray_traverse_miss(ray, |_r, id| {
+                    if test(bvh.primitive_indices[id] as usize) {
+                        0.0
+                    } else {
+                        f32::INFINITY
+                    }
+                })
+            }
+        }
+    }
+
     /// Number of shapes.
     pub fn len(&self) -> usize {
         self.shapes.len()

@@ -105,6 +105,8 @@ pub struct Effects {
     pub ambient: bool,
     /// Specular reflection/transmission rays.
     pub specular: bool,
+    /// Shadow rays to distant sources stop at the first surface (no material passes them).
+    pub occlusion_shadows: bool,
     /// One line per effect with its reason.
     pub notes: Vec<String>,
 }
@@ -124,6 +126,7 @@ pub struct Tracer {
     opts: TraceOptions,
     effects: Effects,
     warnings: Vec<String>,
+    rays: std::sync::atomic::AtomicU64,
 }
 
 fn maxc(c: DVec3) -> f64 {
@@ -359,6 +362,28 @@ impl Tracer {
         if opts.full {
             notes.push("effect selection disabled: full integrator".into());
         }
+        let passes_shadows = mats.values().any(|m| match m {
+            Material::Glass { .. } => true,
+            Material::Normal {
+                trans,
+                tspec,
+                rough,
+                ..
+            } => *trans > FTINY && *tspec > FTINY && rough * rough <= FTINY,
+            Material::Light {
+                kind: LightKind::Illum(_),
+                ..
+            } => true,
+            _ => false,
+        });
+        let occlusion_shadows = !passes_shadows && !opts.full;
+        notes.push(if passes_shadows {
+            "shadow rays: traced through surfaces (glass, illum or transmitting materials present)"
+                .into()
+        } else {
+            "shadow rays to distant sources: occlusion test only (no material lets them through)"
+                .into()
+        });
         let specular = specular || opts.full;
         Ok(Tracer {
             accel: Accel::new(shapes),
@@ -373,9 +398,11 @@ impl Tracer {
                 direct,
                 ambient,
                 specular,
+                occlusion_shadows,
                 notes,
             },
             warnings,
+            rays: std::sync::atomic::AtomicU64::new(0),
         })
     }
 
@@ -601,8 +628,28 @@ impl Tracer {
         });
     }
 
+    /// Number of rays traced so far (all kinds).
+    pub fn rays_traced(&self) -> u64 {
+        self.rays.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
     fn trace(&self, r: &Ray, cx: &mut Ctx) -> DVec3 {
+        self.rays.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let tmin = Self::tmin(r.org);
+        if self.effects.occlusion_shadows && r.flags & SHADOW != 0 {
+            if let Some(s) = r.src {
+                if let SourceGeom::Distant(k) = self.sources[s].geom {
+                    if self.accel.occluded(r.org, r.dir, tmin, r.tmax, r.skip) {
+                        return DVec3::ZERO;
+                    }
+                    let d = &self.distant[k];
+                    let (val, zeroed) =
+                        self.shade_light(r, d.mat, 1.0, f64::INFINITY, DVec3::ZERO, None, cx);
+                    self.report(cx, r, d.prim, val, r.org, -r.dir, 1e10, zeroed);
+                    return val;
+                }
+            }
+        }
         match self.accel.closest(r.org, r.dir, tmin, r.tmax, r.skip) {
             None => {
                 if r.tmax.is_finite() {

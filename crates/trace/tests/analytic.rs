@@ -76,3 +76,34 @@ fn interreflection_inside_a_diffuse_sphere() {
     // sphere's own shadow (area ratio 2.5e-5) and 5 standard errors.
     assert!((got - want).abs() < 0.015 * want, "got {got}, want {want}");
 }
+
+#[test]
+fn effect_selection_gives_the_same_numbers_as_the_full_integrator() {
+    // opaque room, sun and sky: the selected integrator uses occlusion-only sun shadows
+    let text = "void plastic w 0 0 5 .5 .5 .5 0 0\n\
+        w polygon floor 0 0 12 0 0 0  0 4 0  4 4 0  4 0 0\n\
+        w polygon wall 0 0 12 0 0 0  4 0 0  4 0 3  0 0 3\n\
+        w polygon box 0 0 12 1 1 .5  2 1 .5  2 2 .5  1 2 .5\n\
+        void light sun 0 0 3 1e5 1e5 1e5\nsun source s 0 0 4 .3 .4 .8 .5\n\
+        void glow sky 0 0 4 1 1 1 0\nsky source d 0 0 4 0 0 1 180\n";
+    let s = scene(text);
+    let base = TraceOptions {
+        ab: 2,
+        ad: 64,
+        ..TraceOptions::rtrace()
+    };
+    let sel = Tracer::new(&s, &base).unwrap();
+    assert!(sel.effects().occlusion_shadows);
+    let full = Tracer::new(&s, &TraceOptions { full: true, ..base }).unwrap();
+    assert!(!full.effects().occlusion_shadows);
+    for i in 0..20u64 {
+        let p = DVec3::new(0.2 * i as f64, 0.1 * i as f64 + 0.5, 0.3);
+        assert_eq!(
+            sel.irradiance(i, p, DVec3::Z),
+            full.irradiance(i, p, DVec3::Z),
+            "point {i}"
+        );
+        let d = DVec3::new(0.1, 0.7, -0.5);
+        assert_eq!(sel.radiance(i, p, d), full.radiance(i, p, d), "ray {i}");
+    }
+}
