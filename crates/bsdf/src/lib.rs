@@ -1,6 +1,15 @@
 //! fenestra-bsdf: Klems angle bases and BSDF data (LBNL/WINDOW 6 XML, Klems matrices and
 //! tensor trees), as Radiance reads and uses them.
 
+mod dom;
 pub mod klems;
+pub mod model;
+pub mod radiance;
+pub mod read;
+pub mod tree;
+pub mod write;
 
 pub use klems::{Frame, KlemsBasis};
+pub use model::{Block, BlockData, Bsdf, DataStructure, Direction, Geometry, KlemsMatrix, Wavelength};
+pub use read::{parse, read_file, XmlError};
+pub use tree::TensorTree;

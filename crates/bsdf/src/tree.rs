@@ -1,0 +1,265 @@
+//! Tensor-tree BSDF data (`TensorTree3` / `TensorTree4`): parse and evaluate.
+//!
+//! A node is `{ child × 2^rank }` (a branch; child `n` covers the upper half of dimension `i`
+//! when bit `i` of `n` is set) or `{ value × 2^(rank·g) }` (a grid with `2^g` cells per
+//! dimension, dimension 0 varying slowest). Lookup is nearest cell, as in Radiance.
+
+use std::f64::consts::FRAC_PI_4;
+
+/// A tensor tree of rank 3 (isotropic) or 4 (anisotropic).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TensorTree {
+    rank: usize,
+    root: Node,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+enum Node {
+    Branch(Vec<Node>),
+    Grid { log2: u32, values: Vec<f32> },
+}
+
+/// A tree parse error: message and byte offset inside the parsed text.
+#[derive(Debug, PartialEq)]
+pub struct TreeError {
+    /// What is wrong.
+    pub message: String,
+    /// Byte offset in the text.
+    pub offset: usize,
+}
+
+impl TensorTree {
+    /// Parses `ScatteringData` text of a tree of the given rank (3 or 4).
+    pub fn parse(rank: usize, text: &str) -> Result<Self, TreeError> {
+        let mut p = Parser { s: text.as_bytes(), i: 0, rank };
+        p.skip();
+        let root = p.node()?;
+        p.skip();
+        if p.i < p.s.len() {
+            return Err(p.err("extra characters after the tree's root node"));
+        }
+        Ok(TensorTree { rank, root })
+    }
+
+    /// The rank (3 or 4).
+    pub fn rank(&self) -> usize {
+        self.rank
+    }
+
+    /// Value at a position in the unit hypercube (`pos.len() == rank`, each in [0,1]).
+    pub fn lookup(&self, pos: &[f64]) -> f64 {
+        let mut p: Vec<f64> = pos.iter().map(|v| v.clamp(0.0, 1.0)).collect();
+        let mut node = &self.root;
+        loop {
+            match node {
+                Node::Branch(ch) => {
+                    let mut idx = 0;
+                    for (i, v) in p.iter_mut().enumerate() {
+                        if *v >= 0.5 {
+                            idx |= 1 << i;
+                            *v = *v * 2.0 - 1.0;
+                        } else {
+                            *v *= 2.0;
+                        }
+                    }
+                    node = &ch[idx];
+                }
+                Node::Grid { log2, values } => {
+                    let n = 1usize << log2;
+                    let mut idx = 0;
+                    for v in &p {
+                        idx = idx * n + ((v * n as f64) as usize).min(n - 1);
+                    }
+                    return values[idx] as f64;
+                }
+            }
+        }
+    }
+
+    /// BSDF (sr⁻¹) for an incident and an outgoing direction, both unit vectors pointing away
+    /// from the surface in the component's frame (Radiance's `SDqueryTre` coordinates).
+    pub fn eval(&self, inc: [f64; 3], out: [f64; 3]) -> f64 {
+        if self.rank == 4 {
+            let a = disk_to_square(-inc[0], -inc[1]);
+            let b = disk_to_square(out[0], out[1]);
+            self.lookup(&[a.0, a.1, b.0, b.1])
+        } else {
+            let r = (inc[0] * inc[0] + inc[1] * inc[1]).sqrt();
+            let p0 = (0.5 - 1e-6) - 0.5 * r;
+            let ang = -(-inc[1]).atan2(-inc[0]);
+            let (s, c) = ang.sin_cos();
+            let rot = [out[0] * c - out[1] * s, out[0] * s + out[1] * c];
+            let b = disk_to_square(rot[0], rot[1]);
+            self.lookup(&[p0.max(0.0), b.0, b.1])
+        }
+    }
+
+    /// Smallest value anywhere in the tree.
+    pub fn min_value(&self) -> f64 {
+        fn walk(n: &Node) -> f64 {
+            match n {
+                Node::Branch(ch) => ch.iter().map(walk).fold(f64::INFINITY, f64::min),
+                Node::Grid { values, .. } => values.iter().map(|&v| v as f64).fold(f64::INFINITY, f64::min),
+            }
+        }
+        walk(&self.root)
+    }
+
+    /// Finest cell size along one dimension (1/2^depth).
+    pub fn finest_cell(&self) -> f64 {
+        fn walk(n: &Node) -> f64 {
+            match n {
+                Node::Branch(ch) => 0.5 * ch.iter().map(walk).fold(1.0, f64::min),
+                Node::Grid { log2, .. } => 1.0 / (1u64 << log2) as f64,
+            }
+        }
+        walk(&self.root)
+    }
+}
+
+/// Shirley–Chiu concentric map from the unit disk to the unit square.
+pub fn disk_to_square(x: f64, y: f64) -> (f64, f64) {
+    let r = (x * x + y * y).sqrt();
+    let mut phi = y.atan2(x);
+    if phi < -FRAC_PI_4 {
+        phi += 2.0 * std::f64::consts::PI;
+    }
+    let (a, b) = if phi < FRAC_PI_4 {
+        (r, phi * r / FRAC_PI_4)
+    } else if phi < 3.0 * FRAC_PI_4 {
+        (-(phi - 2.0 * FRAC_PI_4) * r / FRAC_PI_4, r)
+    } else if phi < 5.0 * FRAC_PI_4 {
+        (-r, (phi - 4.0 * FRAC_PI_4) * -r / FRAC_PI_4)
+    } else {
+        (-(phi - 6.0 * FRAC_PI_4) * -r / FRAC_PI_4, -r)
+    };
+    const S: f64 = 0.5 / 0.9999999999999;
+    (a * S + 0.5, b * S + 0.5)
+}
+
+/// Shirley–Chiu concentric map from the unit square to the unit disk (inverse of
+/// [`disk_to_square`]).
+pub fn square_to_disk(u: f64, v: f64) -> (f64, f64) {
+    let a = 2.0 * u - 1.0;
+    let b = 2.0 * v - 1.0;
+    let (r, phi) = if a == 0.0 && b == 0.0 {
+        (0.0, 0.0)
+    } else if a > -b {
+        if a > b {
+            (a, FRAC_PI_4 * (b / a))
+        } else {
+            (b, FRAC_PI_4 * (2.0 - a / b))
+        }
+    } else if a < b {
+        (-a, FRAC_PI_4 * (4.0 + b / a))
+    } else {
+        (-b, if b != 0.0 { FRAC_PI_4 * (6.0 - a / b) } else { 0.0 })
+    };
+    let r = r * 0.9999999999999;
+    (r * phi.cos(), r * phi.sin())
+}
+
+struct Parser<'a> {
+    s: &'a [u8],
+    i: usize,
+    rank: usize,
+}
+
+impl Parser<'_> {
+    fn err(&self, m: &str) -> TreeError {
+        TreeError { message: m.to_string(), offset: self.i }
+    }
+
+    fn skip(&mut self) {
+        while self.i < self.s.len() && (self.s[self.i].is_ascii_whitespace() || self.s[self.i] == b',') {
+            self.i += 1;
+        }
+    }
+
+    fn node(&mut self) -> Result<Node, TreeError> {
+        if self.s.get(self.i) != Some(&b'{') {
+            return Err(self.err("expected '{'"));
+        }
+        self.i += 1;
+        self.skip();
+        if self.s.get(self.i) == Some(&b'{') {
+            let n = 1 << self.rank;
+            let mut ch = Vec::with_capacity(n);
+            for _ in 0..n {
+                ch.push(self.node()?);
+                self.skip();
+            }
+            if self.s.get(self.i) != Some(&b'}') {
+                return Err(self.err(&format!("expected '}}' after {n} child nodes")));
+            }
+            self.i += 1;
+            return Ok(Node::Branch(ch));
+        }
+        let mut values = Vec::new();
+        loop {
+            self.skip();
+            match self.s.get(self.i) {
+                Some(b'}') => {
+                    self.i += 1;
+                    break;
+                }
+                None => return Err(self.err("unexpected end of data inside a node")),
+                _ => {}
+            }
+            let start = self.i;
+            while self.i < self.s.len() && !matches!(self.s[self.i], b'}' | b'{' | b',') && !self.s[self.i].is_ascii_whitespace() {
+                self.i += 1;
+            }
+            let tok = std::str::from_utf8(&self.s[start..self.i]).unwrap_or("?");
+            let v: f64 = tok
+                .parse()
+                .map_err(|_| TreeError { message: format!("bad number '{tok}'"), offset: start })?;
+            if !v.is_finite() {
+                return Err(TreeError { message: format!("non-finite value '{tok}'"), offset: start });
+            }
+            if v < 0.0 {
+                return Err(TreeError { message: format!("negative BSDF value {tok}"), offset: start });
+            }
+            values.push(v as f32);
+        }
+        let mut log2 = 0u32;
+        let mut k = 1usize;
+        while k < values.len() {
+            k <<= self.rank;
+            log2 += 1;
+        }
+        if k != values.len() {
+            return Err(self.err(&format!("illegal value count {} in a rank-{} leaf", values.len(), self.rank)));
+        }
+        Ok(Node::Grid { log2, values })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parse_and_lookup() {
+        // rank 3: root branch of 8; child 0 a 2x2x2 grid, others constants.
+        let t = TensorTree::parse(3, "{ { 1 2 3 4 5 6 7 8 } {9} {9} {9} {9} {9} {9} {10}, }").unwrap();
+        assert_eq!(t.lookup(&[0.1, 0.1, 0.1]), 1.0);
+        assert_eq!(t.lookup(&[0.1, 0.1, 0.3]), 2.0);
+        assert_eq!(t.lookup(&[0.3, 0.1, 0.1]), 5.0);
+        assert_eq!(t.lookup(&[0.9, 0.9, 0.9]), 10.0);
+        assert_eq!(t.lookup(&[0.9, 0.1, 0.1]), 9.0);
+        assert!(TensorTree::parse(3, "{1 2 3}").is_err());
+        assert!(TensorTree::parse(3, "{1} x").is_err());
+        assert!(TensorTree::parse(3, "{-1}").is_err());
+        assert!(TensorTree::parse(4, "{ {1} }").is_err());
+    }
+
+    #[test]
+    fn disk_square_round_trip() {
+        for &(x, y) in &[(0.3, 0.2), (-0.5, 0.1), (-0.2, -0.7), (0.1, -0.4), (0.0, 0.9)] {
+            let (u, v) = disk_to_square(x, y);
+            let (x2, y2) = square_to_disk(u, v);
+            assert!((x - x2).abs() < 1e-9 && (y - y2).abs() < 1e-9, "{x} {y} -> {x2} {y2}");
+        }
+    }
+}

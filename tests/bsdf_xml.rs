@@ -1,0 +1,214 @@
+//! BSDF XML reading and the matrix Radiance builds from it (tests/fixtures/threephase).
+
+mod common;
+
+use fenestra_bsdf::radiance::transmission_matrix;
+use fenestra_bsdf::write::klems_xml;
+use fenestra_bsdf::{read_file, Block, BlockData, Bsdf, Direction, KlemsBasis, KlemsMatrix, Wavelength};
+use std::path::Path;
+
+/// Reads a float32 RGB matrix with a Radiance header (as `rmtxop -ff` writes).
+fn read_float_matrix(path: &std::path::Path) -> (usize, usize, Vec<[f32; 3]>) {
+    parse_float_matrix(&std::fs::read(path).unwrap())
+}
+
+fn parse_float_matrix(bytes: &[u8]) -> (usize, usize, Vec<[f32; 3]>) {
+    let end = bytes.windows(2).position(|w| w == b"\n\n").unwrap() + 2;
+    let header = String::from_utf8_lossy(&bytes[..end]);
+    let get = |k: &str| -> usize {
+        header.lines().find_map(|l| l.strip_prefix(k)).unwrap().trim().parse().unwrap()
+    };
+    let (rows, cols) = (get("NROWS="), get("NCOLS="));
+    assert!(header.contains("FORMAT=float"));
+    let vals: Vec<f32> =
+        bytes[end..].chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
+    assert_eq!(vals.len(), rows * cols * 3);
+    (rows, cols, vals.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
+}
+
+#[test]
+fn blinds_kf_structure() {
+    let b = read_file(&common::fixture("threephase/blinds_kf.xml")).unwrap();
+    assert_eq!(b.blocks.len(), 12);
+    assert!(b.has_colour());
+    assert!(b.geometry.as_ref().unwrap().mgf.contains("Curved venetian blind"));
+    assert!((b.width.unwrap() - 0.3).abs() < 1e-12);
+    let t = b.klems(Direction::TransmissionFront, &Wavelength::Visible).unwrap();
+    assert_eq!((t.incident.len(), t.outgoing.len()), (145, 145));
+}
+
+/// CIE XYZ of an RGB triple (inverse of Radiance's XYZ → RGB for its standard primaries).
+fn rgb_to_xyz(c: [f64; 3]) -> [f64; 3] {
+    let m = fenestra_bsdf::radiance::xyz_to_rgb_matrix();
+    // Solve m · xyz = c by Cramer's rule.
+    let det = |a: [[f64; 3]; 3]| {
+        a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+            + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
+    };
+    let d = det(m);
+    let mut out = [0.0; 3];
+    for (k, o) in out.iter_mut().enumerate() {
+        let mut a = m;
+        for r in 0..3 {
+            a[r][k] = c[r];
+        }
+        *o = det(a) / d;
+    }
+    out
+}
+
+fn uv(xyz: [f64; 3]) -> (f64, f64) {
+    let d = xyz[0] + 15.0 * xyz[1] + 3.0 * xyz[2];
+    (4.0 * xyz[0] / d, 9.0 * xyz[1] / d)
+}
+
+#[test]
+fn oracle_blinds_kf_matrix_equals_rmtxop() {
+    // T.mtx = the oracle's `rmtxop -ff blinds_kf.xml` (float32). Radiance keeps each element's
+    // CIE Y exactly but stores its chromaticity as u',v' quantised to steps of 1/410 with a random
+    // dither (ccolor.c c_encodeChroma), so RGB channels differ from the exact XYZ → RGB conversion
+    // we use by up to one quantisation step. We therefore test: (1) the luminance Y of every element
+    // to float32 precision (1e-5 relative covers float32 storage, 6e-8, and the 4-digit primaries'
+    // round-off in Y = .265R+.670G+.065B); (2) u',v' within 1/410 (+1e-5 for float32 round-off).
+    let b = read_file(&common::fixture("threephase/blinds_kf.xml")).unwrap();
+    let t = transmission_matrix(&b).unwrap();
+    let (rows, cols, want) = read_float_matrix(&common::fixture("threephase/T.mtx"));
+    assert_eq!((t.rows, t.cols), (rows, cols));
+    let (mut worst_y, mut worst_uv, mut worst_rgb) = (0.0f64, 0.0f64, [0.0f64; 3]);
+    for (k, w) in want.iter().enumerate() {
+        let w = [w[0] as f64, w[1] as f64, w[2] as f64];
+        let g = t.data[k];
+        let (gy, wy) = (rgb_to_xyz(g), rgb_to_xyz(w));
+        if wy[1] > 1e-6 {
+            worst_y = worst_y.max((gy[1] / wy[1] - 1.0).abs());
+            let (gu, gv) = uv(gy);
+            let (wu, wv) = uv(wy);
+            worst_uv = worst_uv.max((gu - wu).abs()).max((gv - wv).abs());
+            for ch in 0..3 {
+                if w[ch] > 1e-6 {
+                    worst_rgb[ch] = worst_rgb[ch].max((g[ch] / w[ch] - 1.0).abs());
+                }
+            }
+        } else {
+            assert!(gy[1].abs() < 1e-6, "element {k}: oracle ~0, fenestra {g:?}");
+        }
+    }
+    eprintln!(
+        "blinds_kf T vs oracle rmtxop: max rel. diff of Y {worst_y:.2e}; max |du'|,|dv'| {worst_uv:.2e} \
+         (quantum 1/410 = {:.2e}); max rel. diff per RGB channel {worst_rgb:?}",
+        1.0 / 410.0
+    );
+    assert!(worst_y < 1e-5, "Y differs by {worst_y:e}");
+    assert!(worst_uv < 1.0 / 410.0 + 1e-5, "chromaticity differs by {worst_uv:e}");
+}
+
+/// The oracle's `rmtxop -ff` of an XML file.
+fn oracle_matrix(o: &common::Oracle, xml: &Path) -> (usize, usize, Vec<[f32; 3]>) {
+    parse_float_matrix(&common::run_ok(o.command("rmtxop").arg("-ff").arg(xml)))
+}
+
+/// Exact agreement for grey data: our f64 value rounded to float32 vs the oracle's float32
+/// (Radiance computes value·λ in double and stores float; 2e-7 relative covers one rounding
+/// each side).
+fn assert_same(tag: &str, t: &fenestra_bsdf::radiance::RgbMatrix, want: (usize, usize, Vec<[f32; 3]>)) {
+    assert_eq!((t.rows, t.cols), (want.0, want.1), "{tag}: dimensions");
+    for (k, w) in want.2.iter().enumerate() {
+        for ch in 0..3 {
+            let (g, w) = (t.data[k][ch], w[ch] as f64);
+            assert!((g - w).abs() <= 2e-7 * w.abs() + 1e-30, "{tag}: element {k} channel {ch}: fenestra {g}, oracle {w}");
+        }
+    }
+}
+
+/// blinds_kf.xml reduced to the blocks `keep` accepts (text surgery on whole WavelengthData elements).
+fn reduced(keep: impl Fn(&str) -> bool, dir: &Path, name: &str) -> std::path::PathBuf {
+    let text = std::fs::read_to_string(common::fixture("threephase/blinds_kf.xml")).unwrap();
+    let mut out = String::new();
+    let mut rest = text.as_str();
+    while let Some(i) = rest.find("<WavelengthData>") {
+        out.push_str(&rest[..i]);
+        let j = rest[i..].find("</WavelengthData>").unwrap() + i + "</WavelengthData>".len();
+        if keep(&rest[i..j]) {
+            out.push_str(&rest[i..j]);
+        }
+        rest = &rest[j..];
+    }
+    out.push_str(rest);
+    let p = dir.join(name);
+    std::fs::write(&p, out).unwrap();
+    p
+}
+
+#[test]
+fn oracle_transmission_back_only_uses_reciprocity() {
+    let Some(o) = common::oracle() else { return };
+    let dir = common::scratch("bsdf-tf-only");
+    let xml = reduced(|b| b.contains(">Visible<") && b.contains("Transmission Back"), &dir, "tf.xml");
+    let ours = transmission_matrix(&read_file(&xml).unwrap()).unwrap();
+    assert_same("Transmission Back only", &ours, oracle_matrix(&o, &xml));
+    // The reflection-only case (sawtooth.xml) gives a 145x145 zero matrix in both.
+    let saw = common::fixture("threephase/sawtooth.xml");
+    let ours = transmission_matrix(&read_file(&saw).unwrap()).unwrap();
+    assert!(ours.data.iter().all(|v| *v == [0.0; 3]));
+    assert_same("sawtooth", &ours, oracle_matrix(&o, &saw));
+}
+
+fn synthetic(incident: &KlemsBasis, outgoing: &KlemsBasis, f: impl Fn(usize, usize) -> f64, dir: Direction) -> Bsdf {
+    let values = (0..outgoing.len()).flat_map(|o| (0..incident.len()).map(move |i| (o, i))).map(|(o, i)| f(o, i)).collect();
+    Bsdf {
+        name: "synthetic".into(),
+        blocks: vec![Block {
+            wavelength: Wavelength::Visible,
+            direction: dir,
+            data_type: "BTDF".into(),
+            data: BlockData::Klems(KlemsMatrix { incident: incident.clone(), outgoing: outgoing.clone(), values }),
+        }],
+        ..Default::default()
+    }
+}
+
+#[test]
+fn oracle_mixed_bases_and_specular_peak() {
+    let Some(o) = common::oracle() else { return };
+    let dir = common::scratch("bsdf-synthetic");
+    let (full, half, quarter) = (KlemsBasis::full(), KlemsBasis::half(), KlemsBasis::quarter());
+    let cases = [
+        ("mixed_tf.xml", synthetic(half, full, |o, i| ((o * 7 + i * 3) % 11) as f64 * 0.01, Direction::TransmissionFront)),
+        ("mixed_tb.xml", synthetic(quarter, half, |o, i| ((o * 5 + i) % 13) as f64 * 0.02, Direction::TransmissionBack)),
+        ("specular.xml", synthetic(full, full, |o, i| if o == i { 1e4 } else { 0.0 }, Direction::TransmissionFront)),
+        ("uniform.xml", synthetic(half, half, |_, _| 0.1, Direction::TransmissionFront)),
+    ];
+    for (name, b) in cases {
+        let p = dir.join(name);
+        std::fs::write(&p, klems_xml(&b, None).unwrap()).unwrap();
+        let ours = transmission_matrix(&read_file(&p).unwrap()).unwrap();
+        assert_same(name, &ours, oracle_matrix(&o, &p));
+    }
+}
+
+#[test]
+fn bad_values_are_errors_with_line() {
+    let dir = common::scratch("bsdf-bad");
+    let b = synthetic(KlemsBasis::quarter(), KlemsBasis::quarter(), |_, _| 0.5, Direction::TransmissionFront);
+    let good = klems_xml(&b, None).unwrap();
+    let line_of = |t: &str, pat: &str| 1 + t[..t.find(pat).unwrap()].matches('\n').count();
+    let first_row = good.find("<ScatteringData>").unwrap();
+    for (tag, bad) in [("nan", "NaN"), ("negative", "-1.000000e0"), ("word", "abc")] {
+        // Replace the 3rd value of the 2nd data line.
+        let mut lines: Vec<String> = good.lines().map(String::from).collect();
+        let l = line_of(&good, "<ScatteringData>") + 1; // 1-based line of the 2nd data line
+        let mut vals: Vec<String> = lines[l - 1].split_whitespace().map(String::from).collect();
+        vals[2] = bad.to_string();
+        lines[l - 1] = format!(" {}", vals.join(" "));
+        let text = lines.join("\n");
+        let p = dir.join(format!("{tag}.xml"));
+        std::fs::write(&p, &text).unwrap();
+        let e = read_file(&p).unwrap_err();
+        assert_eq!(e.line, l, "{tag}: {e}");
+        assert!(e.to_string().contains(bad), "{tag}: {e}");
+    }
+    // Missing values: cut the data short.
+    let cut = good[..first_row].to_string() + "<ScatteringData> 1 2 3 </ScatteringData></WavelengthDataBlock></WavelengthData></Layer></Optical></WindowElement>";
+    let e = fenestra_bsdf::parse(&cut, "cut.xml").unwrap_err();
+    assert!(e.message.contains("has 3 values, expected 1681"), "{e}");
+}
