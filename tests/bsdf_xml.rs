@@ -4,7 +4,9 @@ mod common;
 
 use fenestra_bsdf::radiance::transmission_matrix;
 use fenestra_bsdf::write::klems_xml;
-use fenestra_bsdf::{read_file, Block, BlockData, Bsdf, Direction, KlemsBasis, KlemsMatrix, Wavelength};
+use fenestra_bsdf::{
+    read_file, Block, BlockData, Bsdf, Direction, KlemsBasis, KlemsMatrix, Wavelength,
+};
 use std::path::Path;
 
 /// Reads a float32 RGB matrix with a Radiance header (as `rmtxop -ff` writes).
@@ -16,14 +18,26 @@ fn parse_float_matrix(bytes: &[u8]) -> (usize, usize, Vec<[f32; 3]>) {
     let end = bytes.windows(2).position(|w| w == b"\n\n").unwrap() + 2;
     let header = String::from_utf8_lossy(&bytes[..end]);
     let get = |k: &str| -> usize {
-        header.lines().find_map(|l| l.strip_prefix(k)).unwrap().trim().parse().unwrap()
+        header
+            .lines()
+            .find_map(|l| l.strip_prefix(k))
+            .unwrap()
+            .trim()
+            .parse()
+            .unwrap()
     };
     let (rows, cols) = (get("NROWS="), get("NCOLS="));
     assert!(header.contains("FORMAT=float"));
-    let vals: Vec<f32> =
-        bytes[end..].chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
+    let vals: Vec<f32> = bytes[end..]
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect();
     assert_eq!(vals.len(), rows * cols * 3);
-    (rows, cols, vals.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
+    (
+        rows,
+        cols,
+        vals.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+    )
 }
 
 #[test]
@@ -31,9 +45,16 @@ fn blinds_kf_structure() {
     let b = read_file(&common::fixture("threephase/blinds_kf.xml")).unwrap();
     assert_eq!(b.blocks.len(), 12);
     assert!(b.has_colour());
-    assert!(b.geometry.as_ref().unwrap().mgf.contains("Curved venetian blind"));
+    assert!(b
+        .geometry
+        .as_ref()
+        .unwrap()
+        .mgf
+        .contains("Curved venetian blind"));
     assert!((b.width.unwrap() - 0.3).abs() < 1e-12);
-    let t = b.klems(Direction::TransmissionFront, &Wavelength::Visible).unwrap();
+    let t = b
+        .klems(Direction::TransmissionFront, &Wavelength::Visible)
+        .unwrap();
     assert_eq!((t.incident.len(), t.outgoing.len()), (145, 145));
 }
 
@@ -42,7 +63,8 @@ fn rgb_to_xyz(c: [f64; 3]) -> [f64; 3] {
     let m = fenestra_bsdf::radiance::xyz_to_rgb_matrix();
     // Solve m · xyz = c by Cramer's rule.
     let det = |a: [[f64; 3]; 3]| {
-        a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+        a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+            - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
             + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
     };
     let d = det(m);
@@ -99,7 +121,10 @@ fn oracle_blinds_kf_matrix_equals_rmtxop() {
         1.0 / 410.0
     );
     assert!(worst_y < 1e-5, "Y differs by {worst_y:e}");
-    assert!(worst_uv < 1.0 / 410.0 + 1e-5, "chromaticity differs by {worst_uv:e}");
+    assert!(
+        worst_uv < 1.0 / 410.0 + 1e-5,
+        "chromaticity differs by {worst_uv:e}"
+    );
 }
 
 /// The oracle's `rmtxop -ff` of an XML file.
@@ -110,12 +135,19 @@ fn oracle_matrix(o: &common::Oracle, xml: &Path) -> (usize, usize, Vec<[f32; 3]>
 /// Exact agreement for grey data: our f64 value rounded to float32 vs the oracle's float32
 /// (Radiance computes value·λ in double and stores float; 2e-7 relative covers one rounding
 /// each side).
-fn assert_same(tag: &str, t: &fenestra_bsdf::radiance::RgbMatrix, want: (usize, usize, Vec<[f32; 3]>)) {
+fn assert_same(
+    tag: &str,
+    t: &fenestra_bsdf::radiance::RgbMatrix,
+    want: (usize, usize, Vec<[f32; 3]>),
+) {
     assert_eq!((t.rows, t.cols), (want.0, want.1), "{tag}: dimensions");
     for (k, w) in want.2.iter().enumerate() {
         for ch in 0..3 {
             let (g, w) = (t.data[k][ch], w[ch] as f64);
-            assert!((g - w).abs() <= 2e-7 * w.abs() + 1e-30, "{tag}: element {k} channel {ch}: fenestra {g}, oracle {w}");
+            assert!(
+                (g - w).abs() <= 2e-7 * w.abs() + 1e-30,
+                "{tag}: element {k} channel {ch}: fenestra {g}, oracle {w}"
+            );
         }
     }
 }
@@ -143,7 +175,11 @@ fn reduced(keep: impl Fn(&str) -> bool, dir: &Path, name: &str) -> std::path::Pa
 fn oracle_transmission_back_only_uses_reciprocity() {
     let Some(o) = common::oracle() else { return };
     let dir = common::scratch("bsdf-tf-only");
-    let xml = reduced(|b| b.contains(">Visible<") && b.contains("Transmission Back"), &dir, "tf.xml");
+    let xml = reduced(
+        |b| b.contains(">Visible<") && b.contains("Transmission Back"),
+        &dir,
+        "tf.xml",
+    );
     let ours = transmission_matrix(&read_file(&xml).unwrap()).unwrap();
     assert_same("Transmission Back only", &ours, oracle_matrix(&o, &xml));
     // The reflection-only case (sawtooth.xml) gives a 145x145 zero matrix in both.
@@ -153,15 +189,27 @@ fn oracle_transmission_back_only_uses_reciprocity() {
     assert_same("sawtooth", &ours, oracle_matrix(&o, &saw));
 }
 
-fn synthetic(incident: &KlemsBasis, outgoing: &KlemsBasis, f: impl Fn(usize, usize) -> f64, dir: Direction) -> Bsdf {
-    let values = (0..outgoing.len()).flat_map(|o| (0..incident.len()).map(move |i| (o, i))).map(|(o, i)| f(o, i)).collect();
+fn synthetic(
+    incident: &KlemsBasis,
+    outgoing: &KlemsBasis,
+    f: impl Fn(usize, usize) -> f64,
+    dir: Direction,
+) -> Bsdf {
+    let values = (0..outgoing.len())
+        .flat_map(|o| (0..incident.len()).map(move |i| (o, i)))
+        .map(|(o, i)| f(o, i))
+        .collect();
     Bsdf {
         name: "synthetic".into(),
         blocks: vec![Block {
             wavelength: Wavelength::Visible,
             direction: dir,
             data_type: "BTDF".into(),
-            data: BlockData::Klems(KlemsMatrix { incident: incident.clone(), outgoing: outgoing.clone(), values }),
+            data: BlockData::Klems(KlemsMatrix {
+                incident: incident.clone(),
+                outgoing: outgoing.clone(),
+                values,
+            }),
         }],
         ..Default::default()
     }
@@ -171,12 +219,43 @@ fn synthetic(incident: &KlemsBasis, outgoing: &KlemsBasis, f: impl Fn(usize, usi
 fn oracle_mixed_bases_and_specular_peak() {
     let Some(o) = common::oracle() else { return };
     let dir = common::scratch("bsdf-synthetic");
-    let (full, half, quarter) = (KlemsBasis::full(), KlemsBasis::half(), KlemsBasis::quarter());
+    let (full, half, quarter) = (
+        KlemsBasis::full(),
+        KlemsBasis::half(),
+        KlemsBasis::quarter(),
+    );
     let cases = [
-        ("mixed_tf.xml", synthetic(half, full, |o, i| ((o * 7 + i * 3) % 11) as f64 * 0.01, Direction::TransmissionFront)),
-        ("mixed_tb.xml", synthetic(quarter, half, |o, i| ((o * 5 + i) % 13) as f64 * 0.02, Direction::TransmissionBack)),
-        ("specular.xml", synthetic(full, full, |o, i| if o == i { 1e4 } else { 0.0 }, Direction::TransmissionFront)),
-        ("uniform.xml", synthetic(half, half, |_, _| 0.1, Direction::TransmissionFront)),
+        (
+            "mixed_tf.xml",
+            synthetic(
+                half,
+                full,
+                |o, i| ((o * 7 + i * 3) % 11) as f64 * 0.01,
+                Direction::TransmissionFront,
+            ),
+        ),
+        (
+            "mixed_tb.xml",
+            synthetic(
+                quarter,
+                half,
+                |o, i| ((o * 5 + i) % 13) as f64 * 0.02,
+                Direction::TransmissionBack,
+            ),
+        ),
+        (
+            "specular.xml",
+            synthetic(
+                full,
+                full,
+                |o, i| if o == i { 1e4 } else { 0.0 },
+                Direction::TransmissionFront,
+            ),
+        ),
+        (
+            "uniform.xml",
+            synthetic(half, half, |_, _| 0.1, Direction::TransmissionFront),
+        ),
     ];
     for (name, b) in cases {
         let p = dir.join(name);
@@ -189,7 +268,12 @@ fn oracle_mixed_bases_and_specular_peak() {
 #[test]
 fn bad_values_are_errors_with_line() {
     let dir = common::scratch("bsdf-bad");
-    let b = synthetic(KlemsBasis::quarter(), KlemsBasis::quarter(), |_, _| 0.5, Direction::TransmissionFront);
+    let b = synthetic(
+        KlemsBasis::quarter(),
+        KlemsBasis::quarter(),
+        |_, _| 0.5,
+        Direction::TransmissionFront,
+    );
     let good = klems_xml(&b, None).unwrap();
     let line_of = |t: &str, pat: &str| 1 + t[..t.find(pat).unwrap()].matches('\n').count();
     let first_row = good.find("<ScatteringData>").unwrap();

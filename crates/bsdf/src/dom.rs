@@ -38,7 +38,10 @@ impl Element {
 
     /// Value of an attribute.
     pub fn attr(&self, name: &str) -> Option<&str> {
-        self.attrs.iter().find(|(k, _)| k == name).map(|(_, v)| v.as_str())
+        self.attrs
+            .iter()
+            .find(|(k, _)| k == name)
+            .map(|(_, v)| v.as_str())
     }
 }
 
@@ -48,7 +51,12 @@ pub fn parse(text: &str) -> Result<Element, (String, usize)> {
     let mut stack: Vec<Element> = vec![Element::default()];
     loop {
         let start = reader.buffer_position() as usize;
-        let ev = reader.read_event().map_err(|e| (format!("XML syntax error: {e}"), reader.error_position() as usize))?;
+        let ev = reader.read_event().map_err(|e| {
+            (
+                format!("XML syntax error: {e}"),
+                reader.error_position() as usize,
+            )
+        })?;
         match ev {
             Event::Start(ref s) | Event::Empty(ref s) => {
                 let is_empty = matches!(ev, Event::Empty(_));
@@ -60,8 +68,13 @@ pub fn parse(text: &str) -> Result<Element, (String, usize)> {
                 };
                 for a in s.attributes() {
                     let a = a.map_err(|e| (format!("bad attribute: {e}"), start))?;
-                    let v = a.unescape_value().map_err(|e| (format!("bad attribute value: {e}"), start))?;
-                    el.attrs.push((String::from_utf8_lossy(a.key.local_name().as_ref()).into_owned(), v.into_owned()));
+                    let v = a
+                        .unescape_value()
+                        .map_err(|e| (format!("bad attribute value: {e}"), start))?;
+                    el.attrs.push((
+                        String::from_utf8_lossy(a.key.local_name().as_ref()).into_owned(),
+                        v.into_owned(),
+                    ));
                 }
                 if is_empty {
                     stack.last_mut().expect("stack").children.push(el);
@@ -97,9 +110,12 @@ pub fn parse(text: &str) -> Result<Element, (String, usize)> {
                         .and_then(char::from_u32)
                         .map(String::from)
                         .unwrap_or_default(),
-                    n if n.starts_with('#') => {
-                        n[1..].parse().ok().and_then(char::from_u32).map(String::from).unwrap_or_default()
-                    }
+                    n if n.starts_with('#') => n[1..]
+                        .parse()
+                        .ok()
+                        .and_then(char::from_u32)
+                        .map(String::from)
+                        .unwrap_or_default(),
                     _ => return Err((format!("unknown entity &{name};"), start)),
                 };
                 push_text(stack.last_mut().expect("stack"), &s, start);
@@ -109,7 +125,13 @@ pub fn parse(text: &str) -> Result<Element, (String, usize)> {
         }
     }
     if stack.len() != 1 {
-        return Err((format!("unexpected end of file inside <{}>", stack.last().map(|e| e.name.as_str()).unwrap_or("")), text.len()));
+        return Err((
+            format!(
+                "unexpected end of file inside <{}>",
+                stack.last().map(|e| e.name.as_str()).unwrap_or("")
+            ),
+            text.len(),
+        ));
     }
     let mut doc = stack.pop().expect("document");
     if doc.children.len() != 1 {
@@ -127,5 +149,8 @@ fn push_text(el: &mut Element, s: &str, pos: usize) {
 
 /// 1-based line number of a byte offset.
 pub fn line_of(text: &str, pos: usize) -> usize {
-    1 + text.as_bytes()[..pos.min(text.len())].iter().filter(|&&b| b == b'\n').count()
+    1 + text.as_bytes()[..pos.min(text.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
 }

@@ -10,6 +10,8 @@ pub mod tree;
 pub mod write;
 
 pub use klems::{Frame, KlemsBasis};
-pub use model::{Block, BlockData, Bsdf, DataStructure, Direction, Geometry, KlemsMatrix, Wavelength};
+pub use model::{
+    Block, BlockData, Bsdf, DataStructure, Direction, Geometry, KlemsMatrix, Wavelength,
+};
 pub use read::{parse, read_file, XmlError};
 pub use tree::TensorTree;

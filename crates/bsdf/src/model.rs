@@ -199,7 +199,9 @@ pub struct Bsdf {
 impl Bsdf {
     /// The block for a direction and wavelength.
     pub fn block(&self, direction: Direction, wavelength: &Wavelength) -> Option<&Block> {
-        self.blocks.iter().find(|b| b.direction == direction && &b.wavelength == wavelength)
+        self.blocks
+            .iter()
+            .find(|b| b.direction == direction && &b.wavelength == wavelength)
     }
 
     /// The Klems matrix for a direction and wavelength.
@@ -212,6 +214,8 @@ impl Bsdf {
 
     /// True if the file holds CIE-X and CIE-Z (or CIE-u/v) blocks besides Visible.
     pub fn has_colour(&self) -> bool {
-        self.blocks.iter().any(|b| matches!(b.wavelength, Wavelength::CieX | Wavelength::CieU))
+        self.blocks
+            .iter()
+            .any(|b| matches!(b.wavelength, Wavelength::CieX | Wavelength::CieU))
     }
 }

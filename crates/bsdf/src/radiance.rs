@@ -33,7 +33,11 @@ pub struct RgbMatrix {
 impl RgbMatrix {
     /// A zero matrix.
     pub fn zeros(rows: usize, cols: usize) -> Self {
-        RgbMatrix { rows, cols, data: vec![[0.0; 3]; rows * cols] }
+        RgbMatrix {
+            rows,
+            cols,
+            data: vec![[0.0; 3]; rows * cols],
+        }
     }
 
     /// Element at (r, c).
@@ -61,7 +65,11 @@ pub fn xyz_to_rgb_matrix() -> [[f64; 3]; 3] {
     // Columns: XYZ of each primary with Y = 1, scaled so R+G+B = white (Y_w = 1).
     let col = |(x, y): (f64, f64)| [x / y, 1.0, (1.0 - x - y) / y];
     let p = [col(prim[0]), col(prim[1]), col(prim[2])];
-    let m = [[p[0][0], p[1][0], p[2][0]], [p[0][1], p[1][1], p[2][1]], [p[0][2], p[1][2], p[2][2]]];
+    let m = [
+        [p[0][0], p[1][0], p[2][0]],
+        [p[0][1], p[1][1], p[2][1]],
+        [p[0][2], p[1][2], p[2][2]],
+    ];
     let w = [wx / wy, 1.0, (1.0 - wx - wy) / wy];
     let s = mul3(&inv3(&m), w);
     let rgb2xyz = [
@@ -81,7 +89,8 @@ fn mul3(m: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
 }
 
 fn inv3(m: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
-    let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+    let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
         + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
     let c = |a: usize, b: usize, c: usize, d: usize| m[a][b] * m[c][d];
     [
@@ -125,25 +134,38 @@ impl Component<'_> {
 }
 
 fn component<'a>(b: &'a Bsdf, d: Direction) -> Result<Option<Component<'a>>, MatrixError> {
-    let Some(blk) = b.block(d, &Wavelength::Visible) else { return Ok(None) };
+    let Some(blk) = b.block(d, &Wavelength::Visible) else {
+        return Ok(None);
+    };
     let y = match &blk.data {
         crate::model::BlockData::Klems(m) => m,
         crate::model::BlockData::Tree(_) => return Err(MatrixError::TensorTree),
     };
     let x = b.klems(d, &Wavelength::CieX);
     let z = b.klems(d, &Wavelength::CieZ);
-    let same = |m: Option<&KlemsMatrix>| m.is_none_or(|m| m.incident == y.incident && m.outgoing == y.outgoing);
+    let same = |m: Option<&KlemsMatrix>| {
+        m.is_none_or(|m| m.incident == y.incident && m.outgoing == y.outgoing)
+    };
     if !same(x) || !same(z) {
         return Err(MatrixError::ColourBasis(d.xml_name()));
     }
-    Ok(Some(Component { y, x, z, m: xyz_to_rgb_matrix() }))
+    Ok(Some(Component {
+        y,
+        x,
+        z,
+        m: xyz_to_rgb_matrix(),
+    }))
 }
 
 /// Lambertian value Radiance would split off a matrix (its minimum if > 0.01/π), and whether
 /// the remainder is kept (largest hemispherical total of the remainder > 0.001).
 pub fn lambertian_split(m: &KlemsMatrix) -> (f64, bool) {
     let min = m.values.iter().copied().fold(f64::INFINITY, f64::min);
-    let lamb = if min > 0.01 / std::f64::consts::PI { min } else { 0.0 };
+    let lamb = if min > 0.01 / std::f64::consts::PI {
+        min
+    } else {
+        0.0
+    };
     let keep = (0..m.incident.len()).any(|i| {
         let h: f64 = (0..m.outgoing.len())
             .map(|o| (m.get(o, i) - lamb) * m.outgoing.projected_solid_angle(o).unwrap_or(0.0))
@@ -153,6 +175,7 @@ pub fn lambertian_split(m: &KlemsMatrix) -> (f64, bool) {
     (lamb, keep)
 }
 
+#[allow(clippy::needless_range_loop)] // index arithmetic mirrors the formulas
 /// The transmission matrix Radiance's `dctimestep`/`rmtxop` build from this BSDF.
 pub fn transmission_matrix(b: &Bsdf) -> Result<RgbMatrix, MatrixError> {
     if let Some(tb) = component(b, Direction::TransmissionFront)? {
@@ -177,8 +200,12 @@ pub fn transmission_matrix(b: &Bsdf) -> Result<RgbMatrix, MatrixError> {
             let (ni, no) = (tf.y.incident.len(), tf.y.outgoing.len());
             // Rows of T: tf incident patches; columns: tf outgoing patches.
             let lam = tf.y.outgoing.lambdas();
-            let rot_in: Vec<usize> = (0..ni).map(|r| tf.y.incident.rotate180(r).unwrap_or(r)).collect();
-            let rot_out: Vec<usize> = (0..no).map(|c| tf.y.outgoing.rotate180(c).unwrap_or(c)).collect();
+            let rot_in: Vec<usize> = (0..ni)
+                .map(|r| tf.y.incident.rotate180(r).unwrap_or(r))
+                .collect();
+            let rot_out: Vec<usize> = (0..no)
+                .map(|c| tf.y.outgoing.rotate180(c).unwrap_or(c))
+                .collect();
             let mut t = RgbMatrix::zeros(ni, no);
             for r in 0..ni {
                 for c in 0..no {
@@ -194,6 +221,7 @@ pub fn transmission_matrix(b: &Bsdf) -> Result<RgbMatrix, MatrixError> {
     Ok(lambertian_only(0.0))
 }
 
+#[allow(clippy::needless_range_loop)]
 fn lambertian_only(value: f64) -> RgbMatrix {
     let full = KlemsBasis::full();
     let lam = full.lambdas();
@@ -211,8 +239,14 @@ fn lambertian_only(value: f64) -> RgbMatrix {
 /// `Reflection Back`) or `-rb` (XML `Reflection Front`): `R[o][i] = BSDF[o][i] · λ_in(i)`.
 /// `None` when the file has no such block.
 pub fn reflection_matrix(b: &Bsdf, front: bool) -> Result<Option<RgbMatrix>, MatrixError> {
-    let d = if front { Direction::ReflectionBack } else { Direction::ReflectionFront };
-    let Some(r) = component(b, d)? else { return Ok(None) };
+    let d = if front {
+        Direction::ReflectionBack
+    } else {
+        Direction::ReflectionFront
+    };
+    let Some(r) = component(b, d)? else {
+        return Ok(None);
+    };
     let (ni, no) = (r.y.incident.len(), r.y.outgoing.len());
     let lam = r.y.incident.lambdas();
     let mut m = RgbMatrix::zeros(no, ni);

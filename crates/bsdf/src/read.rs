@@ -4,7 +4,9 @@ use std::path::Path;
 
 use crate::dom::{self, line_of, Element};
 use crate::klems::KlemsBasis;
-use crate::model::{Block, BlockData, Bsdf, DataStructure, Direction, Geometry, KlemsMatrix, Wavelength};
+use crate::model::{
+    Block, BlockData, Bsdf, DataStructure, Direction, Geometry, KlemsMatrix, Wavelength,
+};
 use crate::tree::TensorTree;
 
 /// An error reading a BSDF XML file, with the 1-based line where it was found.
@@ -31,15 +33,28 @@ pub fn read_file(path: &Path) -> Result<Bsdf, XmlError> {
 
 /// Parses BSDF XML text; `file` names it in error messages.
 pub fn parse(text: &str, file: &str) -> Result<Bsdf, XmlError> {
-    let err = |pos: usize, message: String| XmlError { file: file.to_string(), line: line_of(text, pos), message };
+    let err = |pos: usize, message: String| XmlError {
+        file: file.to_string(),
+        line: line_of(text, pos),
+        message,
+    };
     let root = dom::parse(text).map_err(|(m, p)| err(p, m))?;
     if root.name != "WindowElement" {
-        return Err(err(root.pos, format!("root element is <{}>, expected <WindowElement>", root.name)));
+        return Err(err(
+            root.pos,
+            format!("root element is <{}>, expected <WindowElement>", root.name),
+        ));
     }
-    let mut bsdf = Bsdf { comments: leading_comments(text), ..Default::default() };
+    let mut bsdf = Bsdf {
+        comments: leading_comments(text),
+        ..Default::default()
+    };
     if let Some(ft) = root.child("FileType") {
         if !ft.text.trim().eq_ignore_ascii_case("BSDF") {
-            return Err(err(ft.pos, format!("FileType is '{}', expected 'BSDF'", ft.text.trim())));
+            return Err(err(
+                ft.pos,
+                format!("FileType is '{}', expected 'BSDF'", ft.text.trim()),
+            ));
         }
     }
     let layer = root
@@ -57,12 +72,18 @@ pub fn parse(text: &str, file: &str) -> Result<Bsdf, XmlError> {
     if let Some(g) = layer.child("Geometry") {
         if let Some(f) = g.attr("format") {
             if !f.eq_ignore_ascii_case("MGF") {
-                return Err(err(g.pos, format!("Geometry format '{f}' is not supported (expected MGF)")));
+                return Err(err(
+                    g.pos,
+                    format!("Geometry format '{f}' is not supported (expected MGF)"),
+                ));
             }
         }
         if let Some(b) = g.child("MGFblock") {
             if !b.text.trim().is_empty() {
-                bsdf.geometry = Some(Geometry { unit: b.attr("unit").unwrap_or("").to_string(), mgf: b.text.clone() });
+                bsdf.geometry = Some(Geometry {
+                    unit: b.attr("unit").unwrap_or("").to_string(),
+                    mgf: b.text.clone(),
+                });
             }
         }
     }
@@ -77,11 +98,14 @@ pub fn parse(text: &str, file: &str) -> Result<Bsdf, XmlError> {
             });
         }
         for ab in dd.children_named("AngleBasis") {
-            bsdf.bases.push(angle_basis(ab).map_err(|(p, m)| err(p, m))?);
+            bsdf.bases
+                .push(angle_basis(ab).map_err(|(p, m)| err(p, m))?);
         }
     }
     for wd in layer.children_named("WavelengthData") {
-        let wl = wd.child("Wavelength").ok_or_else(|| err(wd.pos, "WavelengthData without <Wavelength>".into()))?;
+        let wl = wd
+            .child("Wavelength")
+            .ok_or_else(|| err(wd.pos, "WavelengthData without <Wavelength>".into()))?;
         let wavelength = Wavelength::parse(&wl.text);
         for blk in wd.children_named("WavelengthDataBlock") {
             let dir_el = blk
@@ -91,22 +115,41 @@ pub fn parse(text: &str, file: &str) -> Result<Bsdf, XmlError> {
                 // Radiance skips blocks with an unknown direction; so do we.
                 continue;
             };
-            let sd = blk.child("ScatteringData").ok_or_else(|| err(blk.pos, "missing <ScatteringData>".into()))?;
-            let structure = bsdf
-                .structure
-                .ok_or_else(|| err(blk.pos, "missing <IncidentDataStructure> in <DataDefinition>".into()))?;
+            let sd = blk
+                .child("ScatteringData")
+                .ok_or_else(|| err(blk.pos, "missing <ScatteringData>".into()))?;
+            let structure = bsdf.structure.ok_or_else(|| {
+                err(
+                    blk.pos,
+                    "missing <IncidentDataStructure> in <DataDefinition>".into(),
+                )
+            })?;
             let data = match structure {
                 DataStructure::TensorTree3 | DataStructure::TensorTree4 => {
-                    let rank = if structure == DataStructure::TensorTree3 { 3 } else { 4 };
-                    let t = TensorTree::parse(rank, &sd.text)
-                        .map_err(|e| err(sd.text_pos + e.offset, format!("ScatteringData: {}", e.message)))?;
+                    let rank = if structure == DataStructure::TensorTree3 {
+                        3
+                    } else {
+                        4
+                    };
+                    let t = TensorTree::parse(rank, &sd.text).map_err(|e| {
+                        err(
+                            sd.text_pos + e.offset,
+                            format!("ScatteringData: {}", e.message),
+                        )
+                    })?;
                     BlockData::Tree(t)
                 }
                 DataStructure::Columns | DataStructure::Rows => {
                     let basis = |tag: &str| -> Result<KlemsBasis, XmlError> {
-                        let el = blk.child(tag).ok_or_else(|| err(blk.pos, format!("missing <{tag}>")))?;
-                        find_basis(&bsdf.bases, el.text.trim())
-                            .ok_or_else(|| err(el.pos, format!("undefined angle basis '{}'", el.text.trim())))
+                        let el = blk
+                            .child(tag)
+                            .ok_or_else(|| err(blk.pos, format!("missing <{tag}>")))?;
+                        find_basis(&bsdf.bases, el.text.trim()).ok_or_else(|| {
+                            err(
+                                el.pos,
+                                format!("undefined angle basis '{}'", el.text.trim()),
+                            )
+                        })
                     };
                     let incident = basis("ColumnAngleBasis")?;
                     let outgoing = basis("RowAngleBasis")?;
@@ -121,11 +164,23 @@ pub fn parse(text: &str, file: &str) -> Result<Bsdf, XmlError> {
                     } else {
                         values
                     };
-                    BlockData::Klems(KlemsMatrix { incident, outgoing, values })
+                    BlockData::Klems(KlemsMatrix {
+                        incident,
+                        outgoing,
+                        values,
+                    })
                 }
             };
-            let data_type = blk.child_text("ScatteringDataType").unwrap_or("").to_string();
-            bsdf.blocks.push(Block { wavelength: wavelength.clone(), direction, data_type, data });
+            let data_type = blk
+                .child_text("ScatteringDataType")
+                .unwrap_or("")
+                .to_string();
+            bsdf.blocks.push(Block {
+                wavelength: wavelength.clone(),
+                direction,
+                data_type,
+                data,
+            });
         }
     }
     Ok(bsdf)
@@ -138,7 +193,9 @@ fn leading_comments(text: &str) -> Vec<String> {
         if rest[..i].contains("<WindowElement") {
             break;
         }
-        let Some(j) = rest[i..].find("-->") else { break };
+        let Some(j) = rest[i..].find("-->") else {
+            break;
+        };
         out.push(rest[i + 4..i + j].trim().to_string());
         rest = &rest[i + j + 3..];
     }
@@ -149,7 +206,10 @@ fn find_basis(bases: &[KlemsBasis], name: &str) -> Option<KlemsBasis> {
     if let Some(b) = KlemsBasis::by_name(name) {
         return Some(b.clone());
     }
-    bases.iter().find(|b| b.name().eq_ignore_ascii_case(name)).cloned()
+    bases
+        .iter()
+        .find(|b| b.name().eq_ignore_ascii_case(name))
+        .cloned()
 }
 
 fn unit_factor(unit: &str) -> Option<f64> {
@@ -169,22 +229,32 @@ pub fn metres_per_unit(unit: &str) -> Option<f64> {
 }
 
 fn length(m: &Element, tag: &str) -> Result<Option<f64>, (usize, String)> {
-    let Some(el) = m.child(tag) else { return Ok(None) };
+    let Some(el) = m.child(tag) else {
+        return Ok(None);
+    };
     let t = el.text.trim();
     if t.is_empty() {
         return Ok(None);
     }
-    let v: f64 = t.parse().map_err(|_| (el.pos, format!("<{tag}> '{t}' is not a number")))?;
+    let v: f64 = t
+        .parse()
+        .map_err(|_| (el.pos, format!("<{tag}> '{t}' is not a number")))?;
     let unit = el.attr("unit").unwrap_or("");
-    let f = unit_factor(unit).ok_or_else(|| (el.pos, format!("<{tag}> has unknown unit '{unit}'")))?;
+    let f =
+        unit_factor(unit).ok_or_else(|| (el.pos, format!("<{tag}> has unknown unit '{unit}'")))?;
     if !(v >= 0.0 && v.is_finite()) {
-        return Err((el.pos, format!("<{tag}> must be a non-negative number, not {t}")));
+        return Err((
+            el.pos,
+            format!("<{tag}> must be a non-negative number, not {t}"),
+        ));
     }
     Ok(Some(v * f))
 }
 
 fn angle_basis(ab: &Element) -> Result<KlemsBasis, (usize, String)> {
-    let name = ab.child_text("AngleBasisName").ok_or((ab.pos, "AngleBasis without <AngleBasisName>".to_string()))?;
+    let name = ab
+        .child_text("AngleBasisName")
+        .ok_or((ab.pos, "AngleBasis without <AngleBasisName>".to_string()))?;
     if let Some(b) = KlemsBasis::by_name(name) {
         return Ok(b.clone()); // Radiance uses its own definition of the standard bases.
     }
@@ -193,22 +263,34 @@ fn angle_basis(ab: &Element) -> Result<KlemsBasis, (usize, String)> {
     for blk in ab.children_named("AngleBasisBlock") {
         let num = |el: Option<&Element>, what: &str| -> Result<f64, (usize, String)> {
             let el = el.ok_or((blk.pos, format!("AngleBasisBlock without <{what}>")))?;
-            el.text.trim().parse().map_err(|_| (el.pos, format!("<{what}> '{}' is not a number", el.text.trim())))
+            el.text.trim().parse().map_err(|_| {
+                (
+                    el.pos,
+                    format!("<{what}> '{}' is not a number", el.text.trim()),
+                )
+            })
         };
         let bounds = blk.child("ThetaBounds");
         let upper = num(bounds.and_then(|b| b.child("UpperTheta")), "UpperTheta")?;
         let lower = num(bounds.and_then(|b| b.child("LowerTheta")), "LowerTheta")?;
         if (lower - prev_upper).abs() > 1e-6 * prev_upper.max(1.0) {
-            return Err((blk.pos, format!("LowerTheta {lower} does not equal the previous UpperTheta {prev_upper}")));
+            return Err((
+                blk.pos,
+                format!("LowerTheta {lower} does not equal the previous UpperTheta {prev_upper}"),
+            ));
         }
         let n = num(blk.child("nPhis"), "nPhis")?;
         if n < 1.0 || n.fract() != 0.0 {
-            return Err((blk.pos, format!("nPhis must be a positive integer, not {n}")));
+            return Err((
+                blk.pos,
+                format!("nPhis must be a positive integer, not {n}"),
+            ));
         }
         rings.push((upper, n as usize));
         prev_upper = upper;
     }
-    KlemsBasis::from_bounds(name, &rings).map_err(|e| (ab.pos, format!("angle basis '{name}': {e}")))
+    KlemsBasis::from_bounds(name, &rings)
+        .map_err(|e| (ab.pos, format!("angle basis '{name}': {e}")))
 }
 
 fn numbers<F>(text: &str, sd: &Element, want: usize, err: &F) -> Result<Vec<f64>, XmlError>
@@ -234,12 +316,23 @@ where
             i += 1;
         }
         let tok = &sd.text[start..i];
-        let v: f64 = tok.parse().map_err(|_| err(sd.text_pos + start, format!("ScatteringData value '{tok}' is not a number")))?;
+        let v: f64 = tok.parse().map_err(|_| {
+            err(
+                sd.text_pos + start,
+                format!("ScatteringData value '{tok}' is not a number"),
+            )
+        })?;
         if !v.is_finite() {
-            return Err(err(sd.text_pos + start, format!("ScatteringData value '{tok}' is not finite")));
+            return Err(err(
+                sd.text_pos + start,
+                format!("ScatteringData value '{tok}' is not finite"),
+            ));
         }
         if v < 0.0 {
-            return Err(err(sd.text_pos + start, format!("ScatteringData value {tok} is negative (a BSDF is >= 0)")));
+            return Err(err(
+                sd.text_pos + start,
+                format!("ScatteringData value {tok} is negative (a BSDF is >= 0)"),
+            ));
         }
         out.push(v);
     }

@@ -31,7 +31,11 @@ pub struct TreeError {
 impl TensorTree {
     /// Parses `ScatteringData` text of a tree of the given rank (3 or 4).
     pub fn parse(rank: usize, text: &str) -> Result<Self, TreeError> {
-        let mut p = Parser { s: text.as_bytes(), i: 0, rank };
+        let mut p = Parser {
+            s: text.as_bytes(),
+            i: 0,
+            rank,
+        };
         p.skip();
         let root = p.node()?;
         p.skip();
@@ -99,7 +103,10 @@ impl TensorTree {
         fn walk(n: &Node) -> f64 {
             match n {
                 Node::Branch(ch) => ch.iter().map(walk).fold(f64::INFINITY, f64::min),
-                Node::Grid { values, .. } => values.iter().map(|&v| v as f64).fold(f64::INFINITY, f64::min),
+                Node::Grid { values, .. } => values
+                    .iter()
+                    .map(|&v| v as f64)
+                    .fold(f64::INFINITY, f64::min),
             }
         }
         walk(&self.root)
@@ -153,7 +160,14 @@ pub fn square_to_disk(u: f64, v: f64) -> (f64, f64) {
     } else if a < b {
         (-a, FRAC_PI_4 * (4.0 + b / a))
     } else {
-        (-b, if b != 0.0 { FRAC_PI_4 * (6.0 - a / b) } else { 0.0 })
+        (
+            -b,
+            if b != 0.0 {
+                FRAC_PI_4 * (6.0 - a / b)
+            } else {
+                0.0
+            },
+        )
     };
     let r = r * 0.9999999999999;
     (r * phi.cos(), r * phi.sin())
@@ -167,11 +181,16 @@ struct Parser<'a> {
 
 impl Parser<'_> {
     fn err(&self, m: &str) -> TreeError {
-        TreeError { message: m.to_string(), offset: self.i }
+        TreeError {
+            message: m.to_string(),
+            offset: self.i,
+        }
     }
 
     fn skip(&mut self) {
-        while self.i < self.s.len() && (self.s[self.i].is_ascii_whitespace() || self.s[self.i] == b',') {
+        while self.i < self.s.len()
+            && (self.s[self.i].is_ascii_whitespace() || self.s[self.i] == b',')
+        {
             self.i += 1;
         }
     }
@@ -207,18 +226,28 @@ impl Parser<'_> {
                 _ => {}
             }
             let start = self.i;
-            while self.i < self.s.len() && !matches!(self.s[self.i], b'}' | b'{' | b',') && !self.s[self.i].is_ascii_whitespace() {
+            while self.i < self.s.len()
+                && !matches!(self.s[self.i], b'}' | b'{' | b',')
+                && !self.s[self.i].is_ascii_whitespace()
+            {
                 self.i += 1;
             }
             let tok = std::str::from_utf8(&self.s[start..self.i]).unwrap_or("?");
-            let v: f64 = tok
-                .parse()
-                .map_err(|_| TreeError { message: format!("bad number '{tok}'"), offset: start })?;
+            let v: f64 = tok.parse().map_err(|_| TreeError {
+                message: format!("bad number '{tok}'"),
+                offset: start,
+            })?;
             if !v.is_finite() {
-                return Err(TreeError { message: format!("non-finite value '{tok}'"), offset: start });
+                return Err(TreeError {
+                    message: format!("non-finite value '{tok}'"),
+                    offset: start,
+                });
             }
             if v < 0.0 {
-                return Err(TreeError { message: format!("negative BSDF value {tok}"), offset: start });
+                return Err(TreeError {
+                    message: format!("negative BSDF value {tok}"),
+                    offset: start,
+                });
             }
             values.push(v as f32);
         }
@@ -229,7 +258,11 @@ impl Parser<'_> {
             log2 += 1;
         }
         if k != values.len() {
-            return Err(self.err(&format!("illegal value count {} in a rank-{} leaf", values.len(), self.rank)));
+            return Err(self.err(&format!(
+                "illegal value count {} in a rank-{} leaf",
+                values.len(),
+                self.rank
+            )));
         }
         Ok(Node::Grid { log2, values })
     }
@@ -242,7 +275,8 @@ mod tests {
     #[test]
     fn parse_and_lookup() {
         // rank 3: root branch of 8; child 0 a 2x2x2 grid, others constants.
-        let t = TensorTree::parse(3, "{ { 1 2 3 4 5 6 7 8 } {9} {9} {9} {9} {9} {9} {10}, }").unwrap();
+        let t =
+            TensorTree::parse(3, "{ { 1 2 3 4 5 6 7 8 } {9} {9} {9} {9} {9} {9} {10}, }").unwrap();
         assert_eq!(t.lookup(&[0.1, 0.1, 0.1]), 1.0);
         assert_eq!(t.lookup(&[0.1, 0.1, 0.3]), 2.0);
         assert_eq!(t.lookup(&[0.3, 0.1, 0.1]), 5.0);
@@ -256,10 +290,19 @@ mod tests {
 
     #[test]
     fn disk_square_round_trip() {
-        for &(x, y) in &[(0.3, 0.2), (-0.5, 0.1), (-0.2, -0.7), (0.1, -0.4), (0.0, 0.9)] {
+        for &(x, y) in &[
+            (0.3, 0.2),
+            (-0.5, 0.1),
+            (-0.2, -0.7),
+            (0.1, -0.4),
+            (0.0, 0.9),
+        ] {
             let (u, v) = disk_to_square(x, y);
             let (x2, y2) = square_to_disk(u, v);
-            assert!((x - x2).abs() < 1e-9 && (y - y2).abs() < 1e-9, "{x} {y} -> {x2} {y2}");
+            assert!(
+                (x - x2).abs() < 1e-9 && (y - y2).abs() < 1e-9,
+                "{x} {y} -> {x2} {y2}"
+            );
         }
     }
 }

@@ -14,13 +14,23 @@ pub enum WriteError {
 }
 
 fn escape(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
 }
 
 fn basis_xml(out: &mut String, b: &KlemsBasis) {
-    let _ = writeln!(out, "\t\t<AngleBasis>\n\t\t\t<AngleBasisName>{}</AngleBasisName>", escape(b.name()));
+    let _ = writeln!(
+        out,
+        "\t\t<AngleBasis>\n\t\t\t<AngleBasisName>{}</AngleBasisName>",
+        escape(b.name())
+    );
     for (i, r) in b.rings().iter().enumerate() {
-        let theta = if i == 0 { 0.0 } else { 0.5 * (r.theta_lo + r.theta_hi) };
+        let theta = if i == 0 {
+            0.0
+        } else {
+            0.5 * (r.theta_lo + r.theta_hi)
+        };
         let _ = writeln!(
             out,
             "\t\t\t<AngleBasisBlock>\n\t\t\t\t<Theta>{theta}</Theta>\n\t\t\t\t<nPhis>{}</nPhis>\n\t\t\t\t<ThetaBounds>\n\t\t\t\t\t<LowerTheta>{}</LowerTheta>\n\t\t\t\t\t<UpperTheta>{}</UpperTheta>\n\t\t\t\t</ThetaBounds>\n\t\t\t</AngleBasisBlock>",
@@ -40,10 +50,22 @@ pub fn klems_xml(b: &Bsdf, comment: Option<&str>) -> Result<String, WriteError> 
     out.push_str("<WindowElement xmlns=\"http://windows.lbl.gov\" xmlns:xsi=\"http://www.w3.org/2001/XMLSchema-instance\" xsi:schemaLocation=\"http://windows.lbl.gov/BSDF-v1.4.xsd\">\n");
     out.push_str("<WindowElementType>System</WindowElementType>\n<FileType>BSDF</FileType>\n<Optical>\n<Layer>\n\t<Material>\n");
     let _ = writeln!(out, "\t\t<Name>{}</Name>", escape(&b.name));
-    let _ = writeln!(out, "\t\t<Manufacturer>{}</Manufacturer>", escape(&b.manufacturer));
-    let dt = if b.device_type.is_empty() { "Other" } else { &b.device_type };
+    let _ = writeln!(
+        out,
+        "\t\t<Manufacturer>{}</Manufacturer>",
+        escape(&b.manufacturer)
+    );
+    let dt = if b.device_type.is_empty() {
+        "Other"
+    } else {
+        &b.device_type
+    };
     let _ = writeln!(out, "\t\t<DeviceType>{}</DeviceType>", escape(dt));
-    for (tag, v) in [("Thickness", b.thickness), ("Width", b.width), ("Height", b.height)] {
+    for (tag, v) in [
+        ("Thickness", b.thickness),
+        ("Width", b.width),
+        ("Height", b.height),
+    ] {
         if let Some(v) = v {
             let _ = writeln!(out, "\t\t<{tag} unit=\"meter\">{v}</{tag}>");
         }
@@ -52,14 +74,22 @@ pub fn klems_xml(b: &Bsdf, comment: Option<&str>) -> Result<String, WriteError> 
     match &b.geometry {
         Some(g) => {
             let unit = if g.unit.is_empty() { "meter" } else { &g.unit };
-            let _ = writeln!(out, "\t<Geometry format=\"MGF\"><MGFblock unit=\"{unit}\">{}</MGFblock></Geometry>", escape(&g.mgf));
+            let _ = writeln!(
+                out,
+                "\t<Geometry format=\"MGF\"><MGFblock unit=\"{unit}\">{}</MGFblock></Geometry>",
+                escape(&g.mgf)
+            );
         }
         None => out.push_str("\t<Geometry></Geometry>\n"),
     }
-    out.push_str("\t<DataDefinition>\n\t\t<IncidentDataStructure>Columns</IncidentDataStructure>\n");
+    out.push_str(
+        "\t<DataDefinition>\n\t\t<IncidentDataStructure>Columns</IncidentDataStructure>\n",
+    );
     let mut seen: Vec<&KlemsBasis> = Vec::new();
     for (k, blk) in b.blocks.iter().enumerate() {
-        let BlockData::Klems(m) = &blk.data else { return Err(WriteError::TensorTree(k)) };
+        let BlockData::Klems(m) = &blk.data else {
+            return Err(WriteError::TensorTree(k));
+        };
         for basis in [&m.incident, &m.outgoing] {
             if !seen.iter().any(|s| s.name() == basis.name()) {
                 seen.push(basis);
@@ -71,7 +101,9 @@ pub fn klems_xml(b: &Bsdf, comment: Option<&str>) -> Result<String, WriteError> 
     }
     out.push_str("\t</DataDefinition>\n");
     for blk in &b.blocks {
-        let BlockData::Klems(m) = &blk.data else { continue };
+        let BlockData::Klems(m) = &blk.data else {
+            continue;
+        };
         let _ = writeln!(
             out,
             "\t<WavelengthData>\n\t\t<LayerNumber>System</LayerNumber>\n\t\t<Wavelength unit=\"Integral\">{}</Wavelength>\n\t\t<SourceSpectrum>CIE Illuminant D65 1nm.ssp</SourceSpectrum>\n\t\t<DetectorSpectrum>ASTM E308 1931 Y.dsp</DetectorSpectrum>\n\t\t<WavelengthDataBlock>\n\t\t\t<WavelengthDataDirection>{}</WavelengthDataDirection>\n\t\t\t<ColumnAngleBasis>{}</ColumnAngleBasis>\n\t\t\t<RowAngleBasis>{}</RowAngleBasis>\n\t\t\t<ScatteringDataType>{}</ScatteringDataType>\n\t\t\t<ScatteringData>",
@@ -106,7 +138,9 @@ mod tests {
     fn round_trip() {
         let inc = KlemsBasis::half().clone();
         let out = KlemsBasis::full().clone();
-        let values: Vec<f64> = (0..inc.len() * out.len()).map(|k| (k % 97) as f64 * 0.125).collect();
+        let values: Vec<f64> = (0..inc.len() * out.len())
+            .map(|k| (k % 97) as f64 * 0.125)
+            .collect();
         let b = Bsdf {
             name: "a<b".into(),
             width: Some(0.5),
@@ -114,7 +148,11 @@ mod tests {
                 wavelength: Wavelength::Visible,
                 direction: Direction::TransmissionFront,
                 data_type: "BTDF".into(),
-                data: BlockData::Klems(KlemsMatrix { incident: inc, outgoing: out, values }),
+                data: BlockData::Klems(KlemsMatrix {
+                    incident: inc,
+                    outgoing: out,
+                    values,
+                }),
             }],
             ..Default::default()
         };
