@@ -14,6 +14,7 @@
 pub mod bvh;
 pub mod material;
 pub mod options;
+pub mod pattern;
 pub mod polygon;
 pub mod rng;
 pub mod shape;

@@ -119,6 +119,8 @@ pub struct Tracer {
     /// Scene index of each BVH shape's material.
     surf_mat: Vec<usize>,
     mats: HashMap<usize, Material>,
+    /// Patterns modifying each material (nearest first).
+    patterns: HashMap<usize, Vec<crate::pattern::Pattern>>,
     /// Scene index of the direct modifier of every primitive.
     modifier_of: Vec<Option<usize>>,
     distant: Vec<Distant>,
@@ -142,7 +144,8 @@ impl Tracer {
         let mut mats: HashMap<usize, Material> = HashMap::new();
         let mut distant = Vec::new();
         let mut warnings = Vec::new();
-        let need_mat = |m: usize, mats: &mut HashMap<usize, Material>| -> Result<()> {
+        let mut patterns: HashMap<usize, Vec<crate::pattern::Pattern>> = HashMap::new();
+        let mut need_mat = |m: usize, mats: &mut HashMap<usize, Material>| -> Result<()> {
             if mats.contains_key(&m) {
                 return Ok(());
             }
@@ -155,12 +158,12 @@ impl Tracer {
                     p.ptype
                 );
             }
-            if let Some(&k) = scene.modifier_chain(m).first() {
-                let q = &scene.prims[k];
-                bail!(
-                    "{}: {} '{}' modifies material '{}': patterns and textures are not supported by fenestra's ray tracer in this build",
-                    q.loc, q.ptype, q.name, p.name
-                );
+            let mut pats = Vec::new();
+            for k in scene.modifier_chain(m) {
+                pats.push(crate::pattern::compile(scene, k, &p.name)?);
+            }
+            if !pats.is_empty() {
+                patterns.insert(m, pats);
             }
             let mat = compile(scene, m)?;
             if let Material::Light {
@@ -391,6 +394,7 @@ impl Tracer {
             surf_mat,
             mats,
             modifier_of,
+            patterns,
             distant,
             sources,
             opts: opts.clone(),
@@ -732,7 +736,7 @@ impl Tracer {
                 )
             }
             Material::Normal {
-                color,
+                color: c0,
                 spec,
                 rough,
                 trans,
@@ -740,7 +744,19 @@ impl Tracer {
                 metal,
             } => (
                 self.shade_normal(
-                    r, *color, *spec, *rough, *trans, *tspec, *metal, shape, p, n, rod, t, cx,
+                    r,
+                    *c0 * self.pattern(m, r.dir),
+                    *spec,
+                    *rough,
+                    *trans,
+                    *tspec,
+                    *metal,
+                    shape,
+                    p,
+                    n,
+                    rod,
+                    t,
+                    cx,
                 ),
                 false,
             ),
@@ -813,7 +829,15 @@ impl Tracer {
                 return (DVec3::ZERO, false);
             }
         }
-        (*color, false)
+        (*color * self.pattern(m, r.dir), false)
+    }
+
+    /// Product of the patterns on material `m` for a ray going along `dir`.
+    fn pattern(&self, m: usize, dir: DVec3) -> DVec3 {
+        match self.patterns.get(&m) {
+            None => DVec3::ONE,
+            Some(ps) => ps.iter().fold(DVec3::ONE, |acc, p| acc * p.eval(dir)),
+        }
     }
 
     #[allow(clippy::too_many_arguments)]
