@@ -7,6 +7,7 @@ pub mod gendaylit;
 pub mod gendaymtx;
 pub mod gensky;
 pub mod genskyvec;
+pub mod pcomb;
 pub mod rtrace;
 pub mod view_opts;
 pub mod vwrays;
@@ -20,6 +21,7 @@ pub fn registry() -> &'static [(&'static str, Run)] {
         ("gendaymtx", gendaymtx::run),
         ("gensky", gensky::run),
         ("genskyvec", genskyvec::run),
+        ("pcomb", pcomb::run),
         ("rtrace", rtrace::run),
         ("vwrays", vwrays::run),
     ]

@@ -391,3 +391,104 @@ mod tests {
         assert_eq!(p.info.view.unwrap().horiz, 180.0);
     }
 }
+
+/// `CAPDATE=` and `GMT=` header lines for now, as Radiance's `fputnow` writes them
+/// (`YYYY:MM:DD HH:MM:SS`); both are written in UTC.
+pub fn capdate_lines() -> [String; 2] {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs() as i64)
+        .unwrap_or(0);
+    let s = format_time(secs);
+    [format!("CAPDATE= {s}"), format!("GMT= {s}")]
+}
+
+/// Seconds since 1970 (UTC) as `YYYY:MM:DD HH:MM:SS`.
+fn format_time(secs: i64) -> String {
+    let days = secs.div_euclid(86400);
+    let rem = secs.rem_euclid(86400);
+    // Civil date from day count (proleptic Gregorian calendar).
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!(
+        "{y:04}:{m:02}:{d:02} {:02}:{:02}:{:02}",
+        rem / 3600,
+        rem / 60 % 60,
+        rem % 60
+    )
+}
+
+#[cfg(test)]
+mod time_tests {
+    #[test]
+    fn known_dates() {
+        assert_eq!(super::format_time(0), "1970:01:01 00:00:00");
+        assert_eq!(super::format_time(1_709_210_096), "2024:02:29 12:34:56");
+    }
+}
+
+#[cfg(test)]
+mod prop_tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn pixel() -> impl Strategy<Value = [f32; 3]> {
+        prop_oneof![
+            Just([0.0f32; 3]),
+            (any::<u8>(), any::<u8>(), 128u8..=255, 30u8..=255, 0usize..3).prop_map(
+                |(a, b, big, e, which)| {
+                    let mut m = [a.min(big), b.min(big), a.min(big)];
+                    m[which] = big;
+                    rgbe::decode([m[0], m[1], m[2], e])
+                }
+            ),
+        ]
+    }
+
+    proptest! {
+        /// Decoded RGBE values survive write + read exactly, any size, runs or not.
+        #[test]
+        fn round_trip(w in 1usize..70, h in 1usize..6, seed in prop::collection::vec(pixel(), 1..40), rep in 1usize..9) {
+            let px: Vec<[f32; 3]> = (0..w * h).map(|i| seed[(i / rep) % seed.len()]).collect();
+            let mut buf = Vec::new();
+            write_picture(&mut buf, Some(&PictureHeader::default()), w, h, &px).unwrap();
+            let p = Picture::read(&mut buf.as_slice(), "t").unwrap();
+            prop_assert_eq!(p.pixels, px);
+        }
+
+        /// Arbitrary floats (tiny, huge, negative, denormal) encode to within one
+        /// mantissa step of the largest channel, negatives to zero.
+        #[test]
+        fn encode_error_bounded(r in any::<f32>(), g in any::<f32>(), b in any::<f32>()) {
+            prop_assume!(r.is_finite() && g.is_finite() && b.is_finite());
+            let c = [r, g, b];
+            let d = rgbe::decode(rgbe::encode(c));
+            let max = r.max(g).max(b) as f64;
+            for k in 0..3 {
+                let want = (c[k] as f64).max(0.0);
+                if max > 1e-32 && max < 1e38 {
+                    prop_assert!((d[k] as f64 - want).abs() <= max / 128.0 + 1e-38, "{:?} -> {:?}", c, d);
+                }
+            }
+        }
+
+        /// Mutated pictures never panic: they decode or give an error.
+        #[test]
+        fn mutations_do_not_panic(pos in 0usize..400, val in any::<u8>(), cut in 0usize..400) {
+            let px: Vec<[f32; 3]> = (0..40 * 3).map(|i| [i as f32 * 0.1, 1.0, (i % 5) as f32]).collect();
+            let mut buf = Vec::new();
+            write_picture(&mut buf, Some(&PictureHeader::default()), 40, 3, &px).unwrap();
+            let p = pos % buf.len();
+            buf[p] = val;
+            buf.truncate(buf.len() - cut % buf.len());
+            let _ = Picture::read(&mut buf.as_slice(), "t");
+        }
+    }
+}
