@@ -12,7 +12,10 @@ fn vimg(n: u32) -> String {
 
 /// The output with the CAPDATE/GMT lines (clock dependent) removed.
 fn stable(out: &[u8]) -> Vec<u8> {
-    let end = out.windows(2).position(|w| w == b"\n\n").map_or(0, |p| p + 1);
+    let end = out
+        .windows(2)
+        .position(|w| w == b"\n\n")
+        .map_or(0, |p| p + 1);
     let head = String::from_utf8_lossy(&out[..end]);
     let mut v: Vec<u8> = head
         .lines()
@@ -51,7 +54,7 @@ fn oracle_pcomb_sums_are_byte_identical() {
     std::fs::write(dir.join("m.f"), mat).unwrap();
     let (v0, v1, v2) = (vimg(0), vimg(1), vimg(2));
     let cases = [
-        format!("{v0}"),
+        v0.to_string(),
         format!("-s 2 {v0} -c 1 2 3 {v1}"),
         format!("-s 0.3 {v0} -s -0.7 {v1} -c 0.1 5 100 {v2}"),
         format!("-ff -s 0.3 {v0} -s -0.7 {v1}"),
@@ -90,7 +93,10 @@ fn size_mismatch_and_bad_input_are_clear_errors() {
         (vec![], "illegal output resolution"),
         (vec!["missing.hdr".into()], "missing.hdr"),
         (vec!["-e".into(), "ro=1".into(), vimg(0)], "not supported"),
-        (vec!["-x".into(), "0".into(), "-y".into(), "2".into()], "-x 0"),
+        (
+            vec!["-x".into(), "0".into(), "-y".into(), "2".into()],
+            "-x 0",
+        ),
     ] {
         let out = common::fenestra("pcomb")
             .current_dir(&dir)
@@ -100,7 +106,10 @@ fn size_mismatch_and_bad_input_are_clear_errors() {
         assert!(!out.status.success(), "{args:?}");
         assert!(out.stdout.is_empty(), "{args:?}: no partial output");
         let err = String::from_utf8_lossy(&out.stderr);
-        assert!(err.starts_with("pcomb: fatal - ") && err.contains(want), "{args:?}: {err}");
+        assert!(
+            err.starts_with("pcomb: fatal - ") && err.contains(want),
+            "{args:?}: {err}"
+        );
     }
     std::fs::remove_dir_all(&dir).ok();
 }
@@ -108,9 +117,19 @@ fn size_mismatch_and_bad_input_are_clear_errors() {
 #[test]
 fn scaled_sum_has_expected_values() {
     use fenestra_formats::picture::Picture;
-    let out = common::run_ok(common::fenestra("pcomb").args(["-s", "0.5", &vimg(4), "-s", "0.5", &vimg(4)]));
+    let out = common::run_ok(common::fenestra("pcomb").args([
+        "-s",
+        "0.5",
+        &vimg(4),
+        "-s",
+        "0.5",
+        &vimg(4),
+    ]));
     let p = Picture::read(&mut out.as_slice(), "t").unwrap();
     let f = std::fs::File::open(vimg(4)).unwrap();
     let q = Picture::read(&mut std::io::BufReader::new(f), "t").unwrap();
-    assert_eq!(p.pixels, q.pixels, "halves of the same picture sum back exactly");
+    assert_eq!(
+        p.pixels, q.pixels,
+        "halves of the same picture sum back exactly"
+    );
 }

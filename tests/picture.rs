@@ -69,7 +69,9 @@ fn every_reference_picture_decodes() {
 fn oracle_reader_matches_pvalue_on_every_reference_picture() {
     let Some(o) = common::oracle() else { return };
     for f in vimg() {
-        let want = floats(&common::run_ok(o.command("pvalue").args(["-h", "-H", "-df"]).arg(&f)));
+        let want = floats(&common::run_ok(
+            o.command("pvalue").args(["-h", "-H", "-df"]).arg(&f),
+        ));
         let got: Vec<f32> = read(&f).pixels.iter().flatten().copied().collect();
         assert!(want == got, "{}: pixel values differ", f.display());
     }
@@ -79,9 +81,17 @@ fn oracle_reader_matches_pvalue_on_every_reference_picture() {
 fn oracle_written_pictures_read_back_identically() {
     let Some(o) = common::oracle() else { return };
     let dir = common::scratch("picture-write");
-    for (k, (w, h)) in [(1usize, 1usize), (1, 9), (9, 1), (16, 3), (17, 4), (33, 17), (300, 2)]
-        .into_iter()
-        .enumerate()
+    for (k, (w, h)) in [
+        (1usize, 1usize),
+        (1, 9),
+        (9, 1),
+        (16, 3),
+        (17, 4),
+        (33, 17),
+        (300, 2),
+    ]
+    .into_iter()
+    .enumerate()
     {
         let px = exact_pixels(w * h, k as u32);
         let hdr = PictureHeader {
@@ -93,7 +103,9 @@ fn oracle_written_pictures_read_back_identically() {
         write_picture(&mut buf, Some(&hdr), w, h, &px).unwrap();
         std::fs::write(&path, &buf).unwrap();
         let want: Vec<f32> = px.iter().flatten().copied().collect();
-        let got = floats(&common::run_ok(o.command("pvalue").args(["-h", "-H", "-df"]).arg(&path)));
+        let got = floats(&common::run_ok(
+            o.command("pvalue").args(["-h", "-H", "-df"]).arg(&path),
+        ));
         assert!(want == got, "{w}x{h}: pvalue reads other values");
     }
     std::fs::remove_dir_all(&dir).ok();
@@ -104,20 +116,28 @@ fn oracle_written_pictures_read_back_identically() {
 fn oracle_encoding_is_byte_identical() {
     let Some(o) = common::oracle() else { return };
     let dir = common::scratch("picture-bytes");
-    for (k, (w, h)) in [(5usize, 3usize), (17, 2), (40, 5), (200, 2)].into_iter().enumerate() {
+    for (k, (w, h)) in [(5usize, 3usize), (17, 2), (40, 5), (200, 2)]
+        .into_iter()
+        .enumerate()
+    {
         // Runs and literals: repeat each value a varying number of times.
         let base = exact_pixels(w * h, 100 + k as u32);
         let px: Vec<[f32; 3]> = (0..w * h).map(|i| base[i / (1 + i % 7)]).collect();
-        let raw: Vec<u8> = px
-            .iter()
-            .flatten()
-            .flat_map(|v| v.to_ne_bytes())
-            .collect();
+        let raw: Vec<u8> = px.iter().flatten().flat_map(|v| v.to_ne_bytes()).collect();
         let rawpath = dir.join(format!("r{k}.f"));
         std::fs::write(&rawpath, &raw).unwrap();
         let theirs = common::run_ok(
             o.command("pvalue")
-                .args(["-r", "-h", "-H", "-df", "-y", &h.to_string(), "+x", &w.to_string()])
+                .args([
+                    "-r",
+                    "-h",
+                    "-H",
+                    "-df",
+                    "-y",
+                    &h.to_string(),
+                    "+x",
+                    &w.to_string(),
+                ])
                 .arg(&rawpath),
         );
         let mut ours = Vec::new();
@@ -164,17 +184,26 @@ fn oracle_all_orientations_reorient() {
         let p = read(f);
         seen.insert(p.res.orient);
         // pvalue prints image-frame coordinates "x y r g b" (y up) for each stored pixel.
-        let text = String::from_utf8(common::run_ok(o.command("pvalue").args(["-h", "-H"]).arg(f)))
-            .unwrap();
+        let text = String::from_utf8(common::run_ok(
+            o.command("pvalue").args(["-h", "-H"]).arg(f),
+        ))
+        .unwrap();
         let (pw, ph, std) = p.to_standard();
         for line in text.lines() {
-            let v: Vec<f64> = line.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            let v: Vec<f64> = line
+                .split_whitespace()
+                .map(|x| x.parse().unwrap())
+                .collect();
             let (x, y) = (v[0] as usize, v[1] as usize);
             let ours = std[(ph - 1 - y) * pw + x];
             for k in 0..3 {
                 // pvalue prints 4 significant digits: compare to that precision.
                 let d = (ours[k] as f64 - v[2 + k]).abs();
-                assert!(d <= 5e-4 * v[2 + k].abs() + 1e-30, "{}: ({x},{y})", f.display());
+                assert!(
+                    d <= 5e-4 * v[2 + k].abs() + 1e-30,
+                    "{}: ({x},{y})",
+                    f.display()
+                );
             }
         }
     }
@@ -188,7 +217,14 @@ fn corrupt_run_length_is_a_clear_error() {
     // so encode one of them with our writer first.
     let p = read(&common::fixture("picture/vimg/v000.hdr"));
     let mut data = Vec::new();
-    write_picture(&mut data, Some(&PictureHeader::default()), 32, 26, &p.pixels).unwrap();
+    write_picture(
+        &mut data,
+        Some(&PictureHeader::default()),
+        32,
+        26,
+        &p.pixels,
+    )
+    .unwrap();
     let start = data.windows(2).position(|w| w == b"\n\n").unwrap() + 2;
     let start = start + data[start..].iter().position(|&b| b == b'\n').unwrap() + 1;
     // Fourth scanline (index 3): find its 02 02 00 20 marker and corrupt the first run code after it.
@@ -203,12 +239,20 @@ fn corrupt_run_length_is_a_clear_error() {
     let dir = common::scratch("picture-corrupt");
     let bad = dir.join("bad.hdr");
     std::fs::write(&bad, &data).unwrap();
-    let e = Picture::read(&mut data.as_slice(), "t").unwrap_err().to_string();
-    assert!(e.contains("scanline 3 of 26") && e.contains("overruns"), "{e}");
+    let e = Picture::read(&mut data.as_slice(), "t")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("scanline 3 of 26") && e.contains("overruns"),
+        "{e}"
+    );
     let out = common::fenestra("pcomb").arg(&bad).output().unwrap();
     assert!(!out.status.success());
     assert!(out.stdout.is_empty(), "no partial output");
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.starts_with("pcomb: fatal - ") && err.contains("bad.hdr") && err.contains("overruns"), "{err}");
+    assert!(
+        err.starts_with("pcomb: fatal - ") && err.contains("bad.hdr") && err.contains("overruns"),
+        "{err}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }

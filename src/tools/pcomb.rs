@@ -1,5 +1,8 @@
 //! pcomb: linear combinations of Radiance pictures (and float RGB matrices).
 
+// Per-channel colour arithmetic reads most clearly with explicit indices.
+#![allow(clippy::needless_range_loop)]
+
 use std::io::{BufRead, Read, Write};
 use std::process::ExitCode;
 
@@ -12,19 +15,58 @@ use fenestra_formats::rgbe;
 use fenestra_formats::view::View;
 
 fn spec() -> Spec {
-    Spec::new("pcomb", "Combine Radiance pictures (sum, scale, colour) to the standard output")
-        .usage("[-h][-w][-ff][-x xres][-y yres] [[-o][-s factor][-c r g b] input ..]")
-        .interleaved(true)
-        .opt(Opt::new("h", Kind::Flag, "leave the inputs' headers out of the output header"))
-        .opt(Opt::new("w", Kind::Flag, "suppress warnings"))
-        .opt(Opt::new("ff", Kind::Flag, "write a float RGB matrix (no clipping of negatives)"))
-        .opt(Opt::new("x", Kind::Word, "output x resolution (default: the inputs')"))
-        .opt(Opt::new("y", Kind::Word, "output y resolution (default: the inputs')"))
-        .opt(Opt::new("e", Kind::Word, "expression (not supported by this fenestra build)"))
-        .opt(Opt::new("f", Kind::Word, "file of expressions (not supported by this fenestra build)"))
-        .opt(Opt::new("o", Kind::Flag, "use original values of the next input (undo its exposure)"))
-        .opt(Opt::new("s", Kind::Real, "scale the next input by a factor"))
-        .opt(Opt::new("c", Kind::Words(3), "scale the next input's r g b by these factors"))
+    Spec::new(
+        "pcomb",
+        "Combine Radiance pictures (sum, scale, colour) to the standard output",
+    )
+    .usage("[-h][-w][-ff][-x xres][-y yres] [[-o][-s factor][-c r g b] input ..]")
+    .interleaved(true)
+    .opt(Opt::new(
+        "h",
+        Kind::Flag,
+        "leave the inputs' headers out of the output header",
+    ))
+    .opt(Opt::new("w", Kind::Flag, "suppress warnings"))
+    .opt(Opt::new(
+        "ff",
+        Kind::Flag,
+        "write a float RGB matrix (no clipping of negatives)",
+    ))
+    .opt(Opt::new(
+        "x",
+        Kind::Word,
+        "output x resolution (default: the inputs')",
+    ))
+    .opt(Opt::new(
+        "y",
+        Kind::Word,
+        "output y resolution (default: the inputs')",
+    ))
+    .opt(Opt::new(
+        "e",
+        Kind::Word,
+        "expression (not supported by this fenestra build)",
+    ))
+    .opt(Opt::new(
+        "f",
+        Kind::Word,
+        "file of expressions (not supported by this fenestra build)",
+    ))
+    .opt(Opt::new(
+        "o",
+        Kind::Flag,
+        "use original values of the next input (undo its exposure)",
+    ))
+    .opt(Opt::new(
+        "s",
+        Kind::Real,
+        "scale the next input by a factor",
+    ))
+    .opt(Opt::new(
+        "c",
+        Kind::Words(3),
+        "scale the next input's r g b by these factors",
+    ))
 }
 
 /// One input picture or matrix, in its stored scanline order.
@@ -133,8 +175,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                     || l.starts_with("NROWS=")
                     || l.starts_with("NCOLS=")
                     || l.starts_with("BigEndian=")
-                    || (inp.original
-                        && (l.starts_with("EXPOSURE=") || l.starts_with("COLORCORR=")))
+                    || (inp.original && (l.starts_with("EXPOSURE=") || l.starts_with("COLORCORR=")))
                 {
                     continue;
                 }
@@ -157,9 +198,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         ));
     } else {
         head.push_str("FORMAT=32-bit_rle_rgbe\n\n");
-        head.push_str(
-            &fenestra_formats::resolution::Resolution::standard(xres, yres).to_string(),
-        );
+        head.push_str(&fenestra_formats::resolution::Resolution::standard(xres, yres).to_string());
     }
 
     let stdout = std::io::stdout();
@@ -260,8 +299,8 @@ fn read_input(name: &str) -> Result<Input> {
             })
         }
         _ => {
-            let info =
-                PictureInfo::from_lines(&lines, "pcomb").with_context(|| format!("input '{name}'"))?;
+            let info = PictureInfo::from_lines(&lines, "pcomb")
+                .with_context(|| format!("input '{name}'"))?;
             let res = read_resolution(&mut r).with_context(|| format!("input '{name}'"))?;
             let pixels = read_pixels(&mut r, &res).with_context(|| format!("input '{name}'"))?;
             let mut view = info.view;
@@ -331,7 +370,11 @@ fn read_matrix(
                 let b = &c[k * size..(k + 1) * size];
                 p[k] = if double {
                     let a: [u8; 8] = b.try_into().unwrap_or([0; 8]);
-                    (if big { f64::from_be_bytes(a) } else { f64::from_le_bytes(a) }) as f32
+                    (if big {
+                        f64::from_be_bytes(a)
+                    } else {
+                        f64::from_le_bytes(a)
+                    }) as f32
                 } else {
                     let a: [u8; 4] = b.try_into().unwrap_or([0; 4]);
                     if big {
