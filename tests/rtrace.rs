@@ -242,3 +242,81 @@ fn reference_mkillum_glass_irradiance() {
         "means: oracle {sum_o} ours {sum_f}"
     );
 }
+
+fn run_scene(text: &str, input: &str, extra: &[&str]) -> std::process::Output {
+    static N: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let k = N.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir = common::scratch(&format!("rtrace_scene_{k}"));
+    let f = dir.join("scene.rad");
+    std::fs::write(&f, text).unwrap();
+    let mut c = common::fenestra("rtrace");
+    c.args(["-h"]).args(extra).arg(&f);
+    let mut child = c
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(input.as_bytes())
+        .unwrap();
+    child.wait_with_output().unwrap()
+}
+
+#[test]
+fn bad_input_gives_one_clear_error_and_no_output() {
+    let cases = [
+        ("void antimatter am 1 glass 0 0\nam sphere s 0 0 4 0 0 0 1\n", "antimatter"),
+        ("void plastic p 0 0 5 .5 .5 .5 0 0\np instance i 1 x.oct 0 0\n", "instance"),
+        ("void brightfunc b 2 f my.cal 0 0\nb plastic p 0 0 5 .5 .5 .5 0 0\np sphere s 0 0 4 0 0 0 1\n", "brightfunc"),
+    ];
+    for (text, what) in cases {
+        let out = run_scene(text, "0 0 5 0 0 -1\n", &[]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{what}: should fail");
+        assert!(
+            out.stdout.is_empty(),
+            "{what}: partial output {:?}",
+            String::from_utf8_lossy(&out.stdout)
+        );
+        assert!(
+            err.contains("fatal") && err.contains(what) && err.contains("scene.rad:"),
+            "{what}: {err}"
+        );
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
+
+#[test]
+fn degenerate_polygon_is_a_warning_and_no_nan() {
+    let text = "void plastic p 0 0 5 .5 .5 .5 0 0\n\
+        p polygon line 0 0 9 0 0 0 1 0 0 2 0 0\n\
+        p polygon dup 0 0 12 0 0 0 0 0 0 1 1 0 1 1 0\n\
+        p polygon ok 0 0 12 -1 -1 0 1 -1 0 1 1 0 -1 1 0\n\
+        void light l 0 0 3 10 10 10\nl sphere bulb 0 0 4 0 0 3 .1\n";
+    let out = run_scene(text, "0 0 1 0 0 -1\n0 0 1 0 0 1\n", &["-ovl"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("degenerate") && err.contains("line"), "{err}");
+    let text_out = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        !text_out.contains("nan") && !text_out.contains("inf"),
+        "{text_out}"
+    );
+    assert_eq!(text_out.lines().count(), 2);
+}
+
+#[test]
+fn concave_polygon_shadow() {
+    // an L-shaped blocker above the point: the notch lets the sun through
+    let text = "void plastic p 0 0 5 .5 .5 .5 0 0\n\
+        p polygon ell 0 0 18 -2 -2 1  2 -2 1  2 0 1  0 0 1  0 2 1  -2 2 1\n\
+        void light s 0 0 3 1e4 1e4 1e4\ns source sun 0 0 4 0 0 1 1\n";
+    let out = run_scene(text, "1 1 0 0 0 1\n-1 -1 0 0 0 1\n", &["-I+"]);
+    let v = values(&out.stdout);
+    assert!(v[0][0] > 0.0, "under the notch: lit {v:?}");
+    assert_eq!(v[1][0], 0.0, "under the polygon: shadowed");
+}

@@ -37,6 +37,13 @@ pub enum Material {
         /// Refractive index.
         n: f64,
     },
+    /// Dielectric volume boundary (Fresnel reflection and Snell refraction).
+    Dielectric {
+        /// Transmission per unit length.
+        tn: DVec3,
+        /// Refractive index (inside).
+        n: f64,
+    },
     /// light, glow, illum, spotlight.
     Light {
         /// Radiance.
@@ -134,6 +141,20 @@ pub fn compile(scene: &Scene, i: usize) -> Result<Material> {
             Material::Glass {
                 tn: rgb(p),
                 n: p.rargs.get(3).copied().unwrap_or(1.52),
+            }
+        }
+        "dielectric" => {
+            need(p, 5)?;
+            if p.rargs[3] <= 0.0 {
+                bail!(
+                    "{}: dielectric '{}': refractive index must be positive",
+                    p.loc,
+                    p.name
+                );
+            }
+            Material::Dielectric {
+                tn: rgb(p),
+                n: p.rargs[3],
             }
         }
         "light" => {

@@ -338,7 +338,7 @@ impl Tracer {
         }
         let modifier_of = scene.prims.iter().map(|p| p.modifier).collect();
         let specular = mats.values().any(|m| match m {
-            Material::Mirror { .. } | Material::Glass { .. } => true,
+            Material::Mirror { .. } | Material::Glass { .. } | Material::Dielectric { .. } => true,
             Material::Normal {
                 spec, trans, tspec, ..
             } => *spec > FTINY || (*trans > FTINY && *tspec > FTINY),
@@ -366,7 +366,7 @@ impl Tracer {
             notes.push("effect selection disabled: full integrator".into());
         }
         let passes_shadows = mats.values().any(|m| match m {
-            Material::Glass { .. } => true,
+            Material::Glass { .. } | Material::Dielectric { .. } => true,
             Material::Normal {
                 trans,
                 tspec,
@@ -723,6 +723,10 @@ impl Tracer {
                 self.shade_glass(r, *tn, *idx, shape, p, n, rod, t, cx),
                 false,
             ),
+            Material::Dielectric { tn, n: idx } => (
+                self.shade_dielectric(r, *tn, *idx, shape, p, n, rod, t, cx),
+                false,
+            ),
             Material::Mirror { color } => {
                 if r.flags & SHADOW != 0 {
                     return (DVec3::ZERO, false);
@@ -838,6 +842,60 @@ impl Tracer {
             None => DVec3::ONE,
             Some(ps) => ps.iter().fold(DVec3::ONE, |acc, p| acc * p.eval(dir)),
         }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn shade_dielectric(
+        &self,
+        r: &Ray,
+        tn: DVec3,
+        idx: f64,
+        shape: usize,
+        p: DVec3,
+        n: DVec3,
+        rod: f64,
+        t: f64,
+        cx: &mut Ctx,
+    ) -> DVec3 {
+        // entering from the front (outside) or leaving from inside
+        let entering = rod > 0.0;
+        let nrm = if entering { n } else { -n };
+        let eta = if entering { 1.0 / idx } else { idx };
+        let cos_i = rod.abs();
+        // absorption along the segment travelled inside the medium
+        let atten = if entering {
+            DVec3::ONE
+        } else {
+            DVec3::new(
+                tn.x.max(1e-300).powf(t),
+                tn.y.max(1e-300).powf(t),
+                tn.z.max(1e-300).powf(t),
+            )
+        };
+        let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
+        let refl_dir = (r.dir + nrm * (2.0 * cos_i)).normalize();
+        if sin2_t >= 1.0 {
+            if r.flags & SHADOW != 0 {
+                return DVec3::ZERO;
+            }
+            return atten * self.spawn(r, p, refl_dir, REFLECTED, DVec3::ONE, shape, t, cx);
+        }
+        let cos_t = (1.0 - sin2_t).sqrt();
+        let rs = ((eta * cos_i - cos_t) / (eta * cos_i + cos_t)).powi(2);
+        let rp = ((eta * cos_t - cos_i) / (eta * cos_t + cos_i)).powi(2);
+        let fr = 0.5 * (rs + rp);
+        let tdir = (r.dir * eta + nrm * (eta * cos_i - cos_t)).normalize();
+        let mut val = DVec3::ZERO;
+        if r.flags & SHADOW != 0 {
+            // a bent shadow ray no longer points at its source, except at index 1
+            if (idx - 1.0).abs() < 1e-6 {
+                val += self.spawn(r, p, r.dir, TRANS, DVec3::splat(1.0 - fr), shape, t, cx);
+            }
+            return atten * val;
+        }
+        val += self.spawn(r, p, tdir, TRANS, DVec3::splat(1.0 - fr), shape, t, cx);
+        val += self.spawn(r, p, refl_dir, REFLECTED, DVec3::splat(fr), shape, t, cx);
+        atten * val
     }
 
     #[allow(clippy::too_many_arguments)]
