@@ -11,6 +11,7 @@
 //! let e = tracer.irradiance(0, glam::DVec3::new(1.0, 1.0, 0.8), glam::DVec3::Z);
 //! ```
 
+pub mod bsdf_mat;
 pub mod bvh;
 pub mod material;
 pub mod options;

@@ -44,6 +44,8 @@ pub enum Material {
         /// Refractive index (inside).
         n: f64,
     },
+    /// Klems BSDF from an XML file.
+    Bsdf(Box<crate::bsdf_mat::BsdfMat>),
     /// light, glow, illum, spotlight.
     Light {
         /// Radiance.
@@ -157,6 +159,7 @@ pub fn compile(scene: &Scene, i: usize) -> Result<Material> {
                 n: p.rargs[3],
             }
         }
+        "BSDF" => Material::Bsdf(Box::new(crate::bsdf_mat::compile(p)?)),
         "light" => {
             need(p, 3)?;
             Material::Light {

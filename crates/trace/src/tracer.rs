@@ -338,7 +338,10 @@ impl Tracer {
         }
         let modifier_of = scene.prims.iter().map(|p| p.modifier).collect();
         let specular = mats.values().any(|m| match m {
-            Material::Mirror { .. } | Material::Glass { .. } | Material::Dielectric { .. } => true,
+            Material::Mirror { .. }
+            | Material::Glass { .. }
+            | Material::Dielectric { .. }
+            | Material::Bsdf(_) => true,
             Material::Normal {
                 spec, trans, tspec, ..
             } => *spec > FTINY || (*trans > FTINY && *tspec > FTINY),
@@ -727,6 +730,7 @@ impl Tracer {
                 self.shade_dielectric(r, *tn, *idx, shape, p, n, rod, t, cx),
                 false,
             ),
+            Material::Bsdf(b) => (self.shade_bsdf(r, b, shape, p, n, t, cx), false),
             Material::Mirror { color } => {
                 if r.flags & SHADOW != 0 {
                     return (DVec3::ZERO, false);
@@ -842,6 +846,63 @@ impl Tracer {
             None => DVec3::ONE,
             Some(ps) => ps.iter().fold(DVec3::ONE, |acc, p| acc * p.eval(dir)),
         }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn shade_bsdf(
+        &self,
+        r: &Ray,
+        b: &crate::bsdf_mat::BsdfMat,
+        shape: usize,
+        p: DVec3,
+        n: DVec3,
+        t: f64,
+        cx: &mut Ctx,
+    ) -> DVec3 {
+        if r.flags & SHADOW != 0 {
+            return DVec3::ZERO;
+        }
+        let z = n;
+        let x =
+            b.up.cross(z)
+                .try_normalize()
+                .unwrap_or_else(|| z.any_orthonormal_vector());
+        let y = z.cross(x);
+        let to_local = |w: DVec3| DVec3::new(w.dot(x), w.dot(y), w.dot(z));
+        let v = to_local(-r.dir);
+        let front = v.z > 0.0;
+        let (refl, trans, rd) = if front {
+            (b.rf.as_deref(), b.tf.as_deref(), b.rd_front)
+        } else {
+            (b.rb.as_deref(), b.tb.as_deref(), b.rd_back)
+        };
+        let td = b.td;
+        let side = if front { z } else { -z };
+        let mut val = self.direct(r, p, side, Some(shape), cx, |l, omega, ldot| {
+            let ll = to_local(l);
+            let same = (ll.z > 0.0) == front;
+            let f = if same {
+                DVec3::splat(refl.map_or(0.0, |c| c.eval(v, ll))) + rd / PI
+            } else {
+                DVec3::splat(trans.map_or(0.0, |c| c.eval(v, ll))) + td / PI
+            };
+            f * (ldot.abs() * omega)
+        });
+        for (comp, flag) in [(refl, REFLECTED), (trans, TRANS)] {
+            let Some(c) = comp else { continue };
+            let (u, u0, u1) = (cx.rng.next_f64(), cx.rng.next_f64(), cx.rng.next_f64());
+            if let Some((d, h)) = c.sample(v, u, u0, u1) {
+                let dir = (x * d.x + y * d.y + z * d.z).normalize();
+                val += self.spawn(r, p, dir, SPECULAR | flag, DVec3::splat(h), shape, t, cx);
+            }
+        }
+        if maxc(rd) > FTINY {
+            val += self.ambient(r, p, side, rd, Some(shape), cx);
+        }
+        if maxc(td) > FTINY {
+            val += self.ambient(r, p, -side, td, Some(shape), cx);
+        }
+        val
     }
 
     #[allow(clippy::too_many_arguments)]

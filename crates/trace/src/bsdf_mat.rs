@@ -1,0 +1,194 @@
+//! The `BSDF` material with a Klems XML file (thickness 0): Radiance's front/back
+//! conventions (front = +Z = surface normal side; XML blocks mapped crosswise) and its
+//! "view vector in" evaluation order, so a room-side viewer looking out uses the
+//! `Transmission Back` block, as Radiance's renderer does.
+
+use std::sync::Arc;
+
+use anyhow::{bail, Context, Result};
+use fenestra_bsdf::{Direction, KlemsMatrix, Wavelength};
+use fenestra_scene::Primitive;
+use glam::DVec3;
+
+/// One Klems component ready for evaluation and sampling.
+#[derive(Debug)]
+pub struct Component {
+    m: KlemsMatrix,
+    /// Per incident patch: cumulative BSDF·λ over outgoing patches.
+    cdf: Vec<Vec<f64>>,
+    /// Whether the outgoing side is the back (−Z) side.
+    out_back: bool,
+    /// Whether the incident (view) vector is on the back side.
+    in_back: bool,
+}
+
+/// A compiled BSDF material.
+#[derive(Debug, Clone)]
+pub struct BsdfMat {
+    /// Up vector (world).
+    pub up: DVec3,
+    /// Reflection for a viewer on the front side (XML Reflection Back).
+    pub rf: Option<Arc<Component>>,
+    /// Reflection for a viewer on the back side (XML Reflection Front).
+    pub rb: Option<Arc<Component>>,
+    /// Transmission for a viewer on the front side (XML Transmission Back).
+    pub tf: Option<Arc<Component>>,
+    /// Transmission for a viewer on the back side (XML Transmission Front).
+    pub tb: Option<Arc<Component>>,
+    /// Extra diffuse reflectance front, back, and diffuse transmittance (real arguments).
+    pub rd_front: DVec3,
+    /// Extra diffuse reflectance of the back side.
+    pub rd_back: DVec3,
+    /// Extra diffuse transmittance.
+    pub td: DVec3,
+}
+
+fn flip(v: DVec3, x: bool, z: bool) -> [f64; 3] {
+    let s = if x { -1.0 } else { 1.0 };
+    [s * v.x, s * v.y, if z { -v.z } else { v.z }]
+}
+
+impl Component {
+    fn new(m: KlemsMatrix, in_back: bool, out_back: bool) -> Component {
+        let ni = m.incident.len();
+        let lam: Vec<f64> = (0..m.outgoing.len())
+            .map(|o| m.outgoing.projected_solid_angle(o).unwrap_or(0.0))
+            .collect();
+        let cdf = (0..ni)
+            .map(|i| {
+                let mut acc = 0.0;
+                lam.iter()
+                    .enumerate()
+                    .map(|(o, l)| {
+                        acc += m.get(o, i).max(0.0) * l;
+                        acc
+                    })
+                    .collect()
+            })
+            .collect();
+        Component {
+            m,
+            cdf,
+            out_back,
+            in_back,
+        }
+    }
+
+    /// Incident index of a view vector `v` (local, pointing away from the surface).
+    fn in_index(&self, v: DVec3) -> Option<usize> {
+        // incident mappings: fi = (-x,-y,z), bi = (-x,-y,-z)
+        self.m.incident.patch(flip(v, true, self.in_back))
+    }
+
+    /// Outgoing index of a light vector `l` (local, pointing away from the surface).
+    fn out_index(&self, l: DVec3) -> Option<usize> {
+        self.m.outgoing.patch(flip(l, false, self.out_back))
+    }
+
+    /// BSDF value (sr⁻¹) for view `v` and light `l`.
+    pub fn eval(&self, v: DVec3, l: DVec3) -> f64 {
+        match (self.in_index(v), self.out_index(l)) {
+            (Some(i), Some(o)) => self.m.get(o, i).max(0.0),
+            _ => 0.0,
+        }
+    }
+
+    /// Samples an outgoing direction for view `v`: (local direction, hemispherical total).
+    pub fn sample(&self, v: DVec3, u: f64, u0: f64, u1: f64) -> Option<(DVec3, f64)> {
+        let i = self.in_index(v)?;
+        let cdf = &self.cdf[i];
+        let tot = *cdf.last()?;
+        if tot <= 0.0 {
+            return None;
+        }
+        let x = u * tot;
+        let o = cdf.partition_point(|&c| c <= x).min(cdf.len() - 1);
+        let d = self.m.outgoing.sample_projected(o, u0, u1)?;
+        let z = if self.out_back { -d[2] } else { d[2] };
+        Some((DVec3::new(d[0], d[1], z), tot))
+    }
+}
+
+/// Compiles a `BSDF` primitive: `6 thick file ux uy uz funcfile`, 0/3/6/9 reals.
+pub fn compile(p: &Primitive) -> Result<BsdfMat> {
+    if p.sargs.len() < 6 {
+        bail!(
+            "{}: BSDF '{}' needs 6 string arguments (thickness, file, up vector, function file)",
+            p.loc,
+            p.name
+        );
+    }
+    if p.sargs.len() > 6 {
+        bail!("{}: BSDF '{}': transforms after the function file are not supported by fenestra's ray tracer", p.loc, p.name);
+    }
+    let num = |k: usize| -> Result<f64> {
+        fenestra_scene::parse_real(&p.sargs[k]).with_context(|| {
+            format!(
+                "{}: BSDF '{}': '{}' is not a number",
+                p.loc, p.name, p.sargs[k]
+            )
+        })
+    };
+    let thick = num(0)?;
+    if thick != 0.0 {
+        bail!("{}: BSDF '{}': non-zero thickness (proxy geometry) is not supported by fenestra's ray tracer", p.loc, p.name);
+    }
+    let up = DVec3::new(num(2)?, num(3)?, num(4)?);
+    if up.length() == 0.0 {
+        bail!("{}: BSDF '{}': zero up vector", p.loc, p.name);
+    }
+    if p.sargs[5] != "." {
+        bail!(
+            "{}: BSDF '{}': function file '{}' is not supported (use '.')",
+            p.loc,
+            p.name,
+            p.sargs[5]
+        );
+    }
+    let path = fenestra_cli::raypath::find_or_err(&p.sargs[1])
+        .with_context(|| format!("{}: BSDF '{}'", p.loc, p.name))?;
+    let b = fenestra_bsdf::read_file(&path)
+        .map_err(|e| anyhow::anyhow!("{}: BSDF '{}': {e}", p.loc, p.name))?;
+    let vis = Wavelength::Visible;
+    if b.blocks
+        .iter()
+        .any(|bl| matches!(bl.data, fenestra_bsdf::BlockData::Tree(_)))
+        && b.klems(Direction::TransmissionFront, &vis).is_none()
+    {
+        bail!("{}: BSDF '{}': tensor-tree BSDF files are not supported by fenestra's ray tracer (Klems only)", p.loc, p.name);
+    }
+    let get = |d: Direction, in_back: bool, out_back: bool| {
+        b.klems(d, &vis)
+            .map(|m| Arc::new(Component::new(m.clone(), in_back, out_back)))
+    };
+    let rf = get(Direction::ReflectionBack, false, false);
+    let rb = get(Direction::ReflectionFront, true, true);
+    let tf = get(Direction::TransmissionBack, false, true);
+    let tb = get(Direction::TransmissionFront, true, false);
+    if rf.is_none() && rb.is_none() && tf.is_none() && tb.is_none() {
+        bail!(
+            "{}: BSDF '{}': '{}' has no visible Klems data",
+            p.loc,
+            p.name,
+            path.display()
+        );
+    }
+    let r = &p.rargs;
+    let v3 = |k: usize| {
+        if r.len() >= k + 3 {
+            DVec3::new(r[k], r[k + 1], r[k + 2])
+        } else {
+            DVec3::ZERO
+        }
+    };
+    Ok(BsdfMat {
+        up,
+        rf,
+        rb,
+        tf,
+        tb,
+        rd_front: v3(0),
+        rd_back: v3(3),
+        td: v3(6),
+    })
+}
