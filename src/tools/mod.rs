@@ -11,6 +11,7 @@ pub mod pcomb;
 pub mod rtrace;
 pub mod view_opts;
 pub mod vwrays;
+pub mod xform;
 
 /// A tool's entry point.
 pub type Run = fn(Vec<String>) -> anyhow::Result<ExitCode>;
@@ -24,5 +25,6 @@ pub fn registry() -> &'static [(&'static str, Run)] {
         ("pcomb", pcomb::run),
         ("rtrace", rtrace::run),
         ("vwrays", vwrays::run),
+        ("xform", xform::run),
     ]
 }

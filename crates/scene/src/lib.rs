@@ -6,8 +6,10 @@ pub mod cfmt;
 pub mod compiled;
 mod model;
 mod rad;
+pub mod transform;
 pub mod types;
 mod words;
+pub mod xform;
 
 pub use model::{Loc, Primitive, Scene};
 pub use rad::{load, parse_str, Parser};

@@ -237,7 +237,10 @@ fn short_command(cmd: &str) -> String {
 }
 
 /// Runs `cmd` through `sh -c` and returns its standard output; a failing command is an error.
-fn command_output(cmd: &str) -> Result<String> {
+pub(crate) fn command_output(cmd: &str) -> Result<String> {
+    if let Some(out) = crate::xform::run_inline(cmd)? {
+        return Ok(out);
+    }
     let out = Command::new("sh")
         .arg("-c")
         .arg(cmd)
@@ -404,6 +407,27 @@ void metal m 0 0 5 1 1 1 0 0\nm sphere s 0 0 4 0 0 0 1\n";
             parse_str("!echo m sphere s 0 0 4 0 0 0 1\n", "t").unwrap_err()
         );
         assert!(e.contains("t:1") && e.contains("undefined modifier"), "{e}");
+    }
+
+    #[test]
+    fn xform_commands_run_in_process() {
+        let d = std::env::temp_dir().join(format!("fenestra-scene-xf-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        let f = d.join("box.rad");
+        std::fs::write(
+            &f,
+            "void plastic m 0 0 5 1 1 1 0 0\nm sphere s 0 0 4 1 0 0 1\n",
+        )
+        .unwrap();
+        let t = format!("!xform -n a -rz 90 -t 0 0 2 {}\n", f.display());
+        let s = parse_str(&t, "t").unwrap();
+        assert_eq!(s.prims[1].name, "a.s");
+        let c = &s.prims[1].rargs;
+        assert!(
+            c[0].abs() < 1e-12 && (c[1] - 1.0).abs() < 1e-12 && c[2] == 2.0,
+            "{c:?}"
+        );
+        let _ = std::fs::remove_dir_all(&d);
     }
 
     #[test]
