@@ -125,3 +125,45 @@ fn clear_dielectric_sphere_conserves_radiance() {
         assert!(v.iter().all(|x| x.is_finite()));
     }
 }
+
+#[test]
+fn contributions_of_a_tracked_sky_add_up_to_its_irradiance() {
+    // open box floor with a sky glow (tracked) and a ground glow (not tracked)
+    let s = scene(
+        "void plastic grey 0 0 5 .5 .5 .5 0 0\ngrey polygon floor 0 0 12 -5 -5 0  5 -5 0  5 5 0  -5 5 0\n\
+         void glow skyglow 0 0 4 2 2 2 0\nskyglow source sky 0 0 4 0 0 1 180\n\
+         void glow groundglow 0 0 4 1 1 1 0\ngroundglow source ground 0 0 4 0 0 -1 180\n",
+    );
+    let opts = TraceOptions {
+        ab: 2,
+        ad: 256,
+        ..TraceOptions::rcontrib()
+    };
+    let t = Tracer::new(&s, &opts).unwrap();
+    let sky = s.prims.iter().position(|p| p.name == "skyglow").unwrap();
+    let mut tracked = vec![false; s.prims.len()];
+    tracked[sky] = true;
+    let (mut coef, mut value) = ([0.0; 3], [0.0; 3]);
+    let mut n = 0;
+    let p = DVec3::new(0.0, 0.0, 1.0);
+    let total = t.contributions_irradiance(3, p, DVec3::Z, &tracked, &mut |c| {
+        assert_eq!(c.modifier, sky);
+        assert!(c.dir.z >= 0.0 && c.total_dist >= 1e10);
+        for k in 0..3 {
+            coef[k] += c.coef[k];
+            value[k] += c.value[k];
+        }
+        n += 1;
+    });
+    assert!(n > 100);
+    // upward-facing point above a floor: it sees only the sky, so the coefficient sum is pi
+    // (stratified sampling of a constant: exact up to rounding) and the value 2 pi
+    assert!((coef[0] - std::f64::consts::PI).abs() < 1e-9, "{coef:?}");
+    assert!(
+        (value[0] - 2.0 * std::f64::consts::PI).abs() < 1e-9,
+        "{value:?}"
+    );
+    assert!((total[0] - value[0]).abs() < 1e-9);
+    // same seed and index without tracking: same irradiance
+    assert_eq!(t.irradiance(3, p, DVec3::Z), total);
+}
