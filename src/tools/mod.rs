@@ -8,6 +8,7 @@ pub mod gendaymtx;
 pub mod gensky;
 pub mod genskyvec;
 pub mod pcomb;
+pub mod rcalc;
 pub mod rtrace;
 pub mod view_opts;
 pub mod vwrays;
@@ -23,6 +24,7 @@ pub fn registry() -> &'static [(&'static str, Run)] {
         ("gensky", gensky::run),
         ("genskyvec", genskyvec::run),
         ("pcomb", pcomb::run),
+        ("rcalc", rcalc::run),
         ("rtrace", rtrace::run),
         ("vwrays", vwrays::run),
         ("xform", xform::run),

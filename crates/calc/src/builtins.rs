@@ -1,0 +1,215 @@
+//! The built-in function library: the 18 functions every calcomp program has, and the
+//! optional extras of rcalc (`in`, Bessel and error functions) and of the renderers (`arg`).
+
+/// A built-in function.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Builtin {
+    /// `if(c, a, b)`: `a` when `c > 0`, else `b`.
+    If,
+    /// `select(n, a1, …)`: the `n`th argument (rounded); `select(0, …)` is the count.
+    Select,
+    /// One-argument math function.
+    Math1(Math1),
+    /// `atan2(y, x)`.
+    Atan2,
+    /// `max(a, …)`.
+    Max,
+    /// `min(a, …)`.
+    Min,
+    /// `rand(x)`: Radiance's deterministic hash in [0, 1).
+    Rand,
+    /// `jn(n, x)` Bessel function of the first kind.
+    Jn,
+    /// `yn(n, x)` Bessel function of the second kind.
+    Yn,
+    /// `in(n)`: input column `n` (rcalc); `in(0)` is the column count.
+    In,
+    /// `arg(n)`: the `n`th real argument of the current primitive; `arg(0)` is the count.
+    Arg,
+}
+
+/// One-argument math functions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Math1 {
+    /// sqrt
+    Sqrt,
+    /// sin
+    Sin,
+    /// cos
+    Cos,
+    /// tan
+    Tan,
+    /// asin
+    Asin,
+    /// acos
+    Acos,
+    /// atan
+    Atan,
+    /// exp
+    Exp,
+    /// natural log
+    Log,
+    /// log10
+    Log10,
+    /// floor
+    Floor,
+    /// ceil
+    Ceil,
+    /// Bessel j0
+    J0,
+    /// Bessel j1
+    J1,
+    /// Bessel y0
+    Y0,
+    /// Bessel y1
+    Y1,
+    /// erf
+    Erf,
+    /// erfc
+    Erfc,
+}
+
+mod libm {
+    extern "C" {
+        pub fn j0(x: f64) -> f64;
+        pub fn j1(x: f64) -> f64;
+        pub fn jn(n: i32, x: f64) -> f64;
+        pub fn y0(x: f64) -> f64;
+        pub fn y1(x: f64) -> f64;
+        pub fn yn(n: i32, x: f64) -> f64;
+        pub fn erf(x: f64) -> f64;
+        pub fn erfc(x: f64) -> f64;
+    }
+}
+
+impl Math1 {
+    /// Applies the function.
+    #[inline]
+    pub fn apply(self, x: f64) -> f64 {
+        match self {
+            Math1::Sqrt => x.sqrt(),
+            Math1::Sin => x.sin(),
+            Math1::Cos => x.cos(),
+            Math1::Tan => x.tan(),
+            Math1::Asin => x.asin(),
+            Math1::Acos => x.acos(),
+            Math1::Atan => x.atan(),
+            Math1::Exp => x.exp(),
+            Math1::Log => x.ln(),
+            Math1::Log10 => x.log10(),
+            Math1::Floor => x.floor(),
+            Math1::Ceil => x.ceil(),
+            // SAFETY: plain C math functions of the system libm, pure on their argument.
+            Math1::J0 => unsafe { libm::j0(x) },
+            // SAFETY: as above.
+            Math1::J1 => unsafe { libm::j1(x) },
+            // SAFETY: as above.
+            Math1::Y0 => unsafe { libm::y0(x) },
+            // SAFETY: as above.
+            Math1::Y1 => unsafe { libm::y1(x) },
+            // SAFETY: as above.
+            Math1::Erf => unsafe { libm::erf(x) },
+            // SAFETY: as above.
+            Math1::Erfc => unsafe { libm::erfc(x) },
+        }
+    }
+}
+
+/// `jn(n, x)` with `n` truncated to an integer as C does.
+pub fn jn(n: f64, x: f64) -> f64 {
+    // SAFETY: plain C math function.
+    unsafe { libm::jn(n as i32, x) }
+}
+
+/// `yn(n, x)` with `n` truncated to an integer as C does.
+pub fn yn(n: f64, x: f64) -> f64 {
+    // SAFETY: plain C math function.
+    unsafe { libm::yn(n as i32, x) }
+}
+
+/// Radiance's `rand(x)`: a deterministic hash of `x` into [0, 1).
+#[inline]
+#[allow(clippy::approx_constant)] // Radiance's truncated constants, kept for identical output
+pub fn rand_hash(x: f64) -> f64 {
+    let mut x = x * (1.0 / (1.0 + x * x) + 2.718_281_828_459_04);
+    x += 0.785_398_163_397_447 - x.floor();
+    x = 1e5 / x;
+    x - x.floor()
+}
+
+/// Which optional groups of built-ins a program has.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Extras {
+    /// rcalc/ev additions: `in`, `j0 j1 jn y0 y1 yn erf erfc`.
+    pub rcalc: bool,
+    /// renderer additions: `arg`, `erf`, `erfc`.
+    pub render: bool,
+}
+
+/// Looks up a built-in by name (with the extras enabled), with its minimum argument count.
+pub fn lookup(name: &str, extras: Extras) -> Option<(Builtin, usize)> {
+    use Builtin as B;
+    use Math1 as M;
+    let core = match name {
+        "if" => Some((B::If, 3)),
+        "select" => Some((B::Select, 1)),
+        "sqrt" => Some((B::Math1(M::Sqrt), 1)),
+        "sin" => Some((B::Math1(M::Sin), 1)),
+        "cos" => Some((B::Math1(M::Cos), 1)),
+        "tan" => Some((B::Math1(M::Tan), 1)),
+        "asin" => Some((B::Math1(M::Asin), 1)),
+        "acos" => Some((B::Math1(M::Acos), 1)),
+        "atan" => Some((B::Math1(M::Atan), 1)),
+        "atan2" => Some((B::Atan2, 2)),
+        "exp" => Some((B::Math1(M::Exp), 1)),
+        "log" => Some((B::Math1(M::Log), 1)),
+        "log10" => Some((B::Math1(M::Log10), 1)),
+        "floor" => Some((B::Math1(M::Floor), 1)),
+        "ceil" => Some((B::Math1(M::Ceil), 1)),
+        "rand" => Some((B::Rand, 1)),
+        "max" => Some((B::Max, 1)),
+        "min" => Some((B::Min, 1)),
+        _ => None,
+    };
+    if core.is_some() {
+        return core;
+    }
+    if extras.rcalc {
+        let r = match name {
+            "in" => Some((B::In, 1)),
+            "j0" => Some((B::Math1(M::J0), 1)),
+            "j1" => Some((B::Math1(M::J1), 1)),
+            "y0" => Some((B::Math1(M::Y0), 1)),
+            "y1" => Some((B::Math1(M::Y1), 1)),
+            "jn" => Some((B::Jn, 2)),
+            "yn" => Some((B::Yn, 2)),
+            _ => None,
+        };
+        if r.is_some() {
+            return r;
+        }
+    }
+    if extras.rcalc || extras.render {
+        match name {
+            "erf" => return Some((B::Math1(M::Erf), 1)),
+            "erfc" => return Some((B::Math1(M::Erfc), 1)),
+            _ => {}
+        }
+    }
+    if extras.render && name == "arg" {
+        return Some((B::Arg, 1));
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rand_matches_radiance_values() {
+        // Values printed by Radiance's rcalc with %.9g.
+        assert_eq!(format!("{:.9}", rand_hash(0.5)), "0.234347013");
+        assert_eq!(format!("{:.8}", rand_hash(1.0)), "0.35008306");
+    }
+}

@@ -1,0 +1,52 @@
+//! The compiled form: expression trees with names resolved to slots.
+
+use crate::builtins::{Builtin, Math1};
+
+/// A function an argument may name (`d1(sin, x)`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum FnTarget {
+    User(u32),
+    Host(u32),
+    Builtin(Builtin),
+}
+
+/// A compiled expression node.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Node {
+    Num(f64),
+    /// A global variable (host-bound or defined).
+    Var(u32),
+    /// `$N` (1-based).
+    Chan(u32),
+    /// The `i`th parameter of the enclosing function.
+    Param(u32),
+    Neg(Box<Node>),
+    Add(Box<(Node, Node)>),
+    Sub(Box<(Node, Node)>),
+    Mul(Box<(Node, Node)>),
+    Div(Box<(Node, Node)>),
+    Pow(Box<(Node, Node)>),
+    If(Box<(Node, Node, Node)>),
+    Math1(Math1, Box<Node>),
+    Atan2(Box<(Node, Node)>),
+    /// Any other built-in (select, min, max, rand, jn, yn, in, arg).
+    Builtin(Builtin, Box<[Node]>),
+    CallUser(u32, Box<[Node]>),
+    CallHost(u32, Box<[Node]>),
+    /// Calling a parameter that names a function.
+    CallParam(u32, Box<[Node]>),
+    /// A function name used as an argument.
+    FuncRef(FnTarget),
+    /// An error found at compile time, raised if evaluated (index in the error table).
+    Fail(u32),
+}
+
+impl Node {
+    /// The constant value, if this is a number.
+    pub(crate) fn num(&self) -> Option<f64> {
+        match self {
+            Node::Num(v) => Some(*v),
+            _ => None,
+        }
+    }
+}
