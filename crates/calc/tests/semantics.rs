@@ -66,13 +66,17 @@ fn runaway_recursion_is_an_error_not_a_crash() {
         .join()
         .unwrap();
     assert_eq!(e.kind, ErrorKind::Recursion);
-    assert_eq!(val("fact(n) = if(n, n*fact(n-1), 1); x = fact(10)", "x").unwrap(), 3628800.0);
+    assert_eq!(
+        val("fact(n) = if(n, n*fact(n-1), 1); x = fact(10)", "x").unwrap(),
+        3628800.0
+    );
 }
 
 #[test]
 fn host_variables_functions_and_channels() {
     let mut p = Program::new();
-    p.load_str("-e", "r = sqrt(Dx*Dx + Dy*Dy) + twice($2)").unwrap();
+    p.load_str("-e", "r = sqrt(Dx*Dx + Dy*Dy) + twice($2)")
+        .unwrap();
     let d = p.bind_vars(&["Dx", "Dy"]);
     p.define_host_fn("twice", 1, Arc::new(|a: &[f64]| 2.0 * a[0]));
     let e = p.add_expr("-b", "r*10").unwrap();
