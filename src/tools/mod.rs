@@ -7,6 +7,7 @@ pub mod gendaylit;
 pub mod gendaymtx;
 pub mod gensky;
 pub mod genskyvec;
+pub mod oconv;
 pub mod pcomb;
 pub mod rcalc;
 pub mod rtrace;
@@ -23,6 +24,7 @@ pub fn registry() -> &'static [(&'static str, Run)] {
         ("gendaymtx", gendaymtx::run),
         ("gensky", gensky::run),
         ("genskyvec", genskyvec::run),
+        ("oconv", oconv::run),
         ("pcomb", pcomb::run),
         ("rcalc", rcalc::run),
         ("rtrace", rtrace::run),

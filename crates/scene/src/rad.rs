@@ -44,8 +44,25 @@ impl Parser {
                 .context("cannot read the scene from standard input")?;
             return self.add_str(&text, "-");
         }
-        let text = read_text(path)?;
+        let bytes =
+            std::fs::read(path).with_context(|| format!("cannot open scene file '{path}'"))?;
+        if crate::compiled::is_compiled(&bytes) || crate::compiled::is_radiance_octree(&bytes) {
+            let c = crate::compiled::read(&bytes).with_context(|| path.to_string())?;
+            return self.add_scene(c.scene);
+        }
+        let text = String::from_utf8(bytes)
+            .map_err(|_| anyhow!("{path}: not a text file (invalid UTF-8)"))?;
         self.add_str(&text, path)
+    }
+
+    /// Appends an already-resolved scene (e.g. a compiled one), shifting its modifier indices.
+    pub fn add_scene(&mut self, scene: Scene) -> Result<()> {
+        let off = self.scene.prims.len();
+        for mut p in scene.prims {
+            p.modifier = p.modifier.map(|m| m + off);
+            self.scene.prims.push(p);
+        }
+        Ok(())
     }
 
     /// Appends primitives produced by a converter (MGF), resolving their modifiers by name.
@@ -78,7 +95,7 @@ impl Parser {
                 b'!' => {
                     let (cmd, open) = w.command();
                     if open {
-                        bail!("{loc}: unterminated !command (the last line ends with '\\' at end of input): !{cmd}");
+                        bail!("{loc}: unterminated !command (the last line ends with '\\' at end of input): !{}", cmd.trim_end());
                     }
                     self.run_command(&cmd, &loc, depth)?;
                 }
@@ -261,7 +278,7 @@ pub(crate) fn read_text(path: &str) -> Result<String> {
         bail!("{path}: this is an octree written by Radiance's oconv, which fenestra cannot read; pass the .rad files instead");
     }
     if crate::compiled::is_compiled(&bytes) {
-        bail!("{path}: this is a compiled scene (fenestra oconv output), not scene text; load it with fenestra_scene::compiled::read");
+        bail!("{path}: this is a compiled scene (fenestra oconv output), not scene text");
     }
     String::from_utf8(bytes).map_err(|_| anyhow!("{path}: not a text file (invalid UTF-8)"))
 }
@@ -274,7 +291,8 @@ pub fn parse_str(text: &str, file: &str) -> Result<Scene> {
 }
 
 /// Loads and concatenates scene inputs (`.rad` or anything else as Radiance text, `.mgf`
-/// as MGF, `-` for standard input); modifiers resolve across files in order.
+/// as MGF, `-` for standard input, compiled scenes from `oconv`); modifiers resolve across
+/// files in order. A Radiance octree is refused with a message to pass the .rad files.
 pub fn load(paths: &[&str]) -> Result<Scene> {
     let mut p = Parser::new();
     for path in paths {

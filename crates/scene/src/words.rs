@@ -74,6 +74,9 @@ impl<'a> Words<'a> {
             cmd.push('\n');
             self.pos += 1;
             self.line += 1;
+            if self.pos >= self.text.len() {
+                return (cmd, true);
+            }
         }
     }
 
@@ -209,6 +212,8 @@ mod tests {
         assert!(!open);
         assert_eq!(w.line(), 2);
         let mut w = Words::new("!echo a \\");
+        assert!(w.command().1);
+        let mut w = Words::new("!echo a \\\n");
         assert!(w.command().1);
     }
 }

@@ -251,7 +251,7 @@ impl Xformer<'_> {
                 b'!' => {
                     let (cmd, open) = w.command();
                     if open {
-                        bail!("{file}:{line}: unterminated !command (the last line ends with '\\' at end of input): !{cmd}");
+                        bail!("{file}:{line}: unterminated !command (the last line ends with '\\' at end of input): !{}", cmd.trim_end());
                     }
                     self.command(&cmd, file, line, out)?;
                 }

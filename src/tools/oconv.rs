@@ -1,0 +1,57 @@
+//! `oconv`: compile scene files (.rad, .mgf) into fenestra's compiled-scene format.
+
+use std::io::Write;
+use std::process::ExitCode;
+
+use anyhow::{bail, Context, Result};
+use fenestra_cli::opts::{Item, Kind, Opt, Spec};
+use fenestra_scene::{compiled, Parser};
+
+fn spec() -> Spec {
+    Spec::new("oconv", "compile Radiance scene files (.rad, .mgf) into a fenestra compiled scene on stdout")
+        .usage("[-i scene.oct] [-f] [-w] [-n objlim] [-r maxres] [-b xmin ymin zmin size] file.rad … > scene.oct")
+        .opt(Opt::new("i", Kind::Word, "start from this compiled scene (fenestra oconv output)"))
+        .opt(Opt::new("f", Kind::Flag, "accepted for compatibility (the whole scene is always stored)"))
+        .opt(Opt::new("w", Kind::Flag, "accepted for compatibility (no warnings are issued)"))
+        .opt(Opt::new("n", Kind::Int, "accepted for compatibility (octree leaf limit; unused)"))
+        .opt(Opt::new("r", Kind::Int, "accepted for compatibility (octree resolution; unused)"))
+        .opt(Opt::new("b", Kind::Words(4), "accepted for compatibility (octree bounds; unused)"))
+}
+
+/// Runs oconv.
+pub fn run(args: Vec<String>) -> Result<ExitCode> {
+    let items = spec().parse(&args)?;
+    let mut parser = Parser::new();
+    let mut inputs = Vec::new();
+    for it in &items {
+        match it {
+            Item::Opt(o) if o.key == "i" => {
+                let c = compiled::read_file(o.word())?;
+                inputs.extend(c.inputs);
+                parser.add_scene(c.scene)?;
+            }
+            Item::Opt(_) => {}
+            Item::Pos(p) => {
+                parser.add_path(p)?;
+                inputs.push(p.clone());
+            }
+        }
+    }
+    if inputs.is_empty() {
+        bail!("no scene files given (usage: oconv file.rad … > scene.oct)");
+    }
+    let scene = parser.finish();
+    let mut buf = Vec::new();
+    compiled::write(
+        &mut buf,
+        &scene,
+        &inputs,
+        &fenestra_cli::command_line(&args),
+        &[],
+    )?;
+    let mut out = std::io::stdout().lock();
+    out.write_all(&buf)
+        .context("cannot write the compiled scene")?;
+    out.flush()?;
+    Ok(ExitCode::SUCCESS)
+}
