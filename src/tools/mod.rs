@@ -3,14 +3,21 @@
 
 use std::process::ExitCode;
 
+pub mod checkbsdf;
+pub mod dctimestep;
 pub mod gendaylit;
 pub mod gendaymtx;
+pub mod genklemsamp;
 pub mod gensky;
 pub mod genskyvec;
+pub mod getinfo;
 pub mod oconv;
 pub mod pcomb;
 pub mod rcalc;
+pub mod rmtxop;
+pub mod rtcontrib;
 pub mod rtrace;
+pub mod total;
 pub mod view_opts;
 pub mod vwrays;
 pub mod xform;
@@ -21,13 +28,22 @@ pub type Run = fn(Vec<String>) -> anyhow::Result<ExitCode>;
 /// Every tool by name (for the multicall `fenestra TOOL …` binary).
 pub fn registry() -> &'static [(&'static str, Run)] {
     &[
+        ("checkBSDF", checkbsdf::run),
+        ("dctimestep", dctimestep::run),
+        ("gendaylit", gendaylit::run),
         ("gendaymtx", gendaymtx::run),
+        ("genklemsamp", genklemsamp::run),
         ("gensky", gensky::run),
         ("genskyvec", genskyvec::run),
+        ("getinfo", getinfo::run),
         ("oconv", oconv::run),
         ("pcomb", pcomb::run),
         ("rcalc", rcalc::run),
+        ("rcontrib", rtcontrib::run),
+        ("rmtxop", rmtxop::run),
+        ("rtcontrib", rtcontrib::run),
         ("rtrace", rtrace::run),
+        ("total", total::run),
         ("vwrays", vwrays::run),
         ("xform", xform::run),
     ]

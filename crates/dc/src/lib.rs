@@ -1,1 +1,4 @@
-//! fenestra-dc (skeleton; see docs/architecture.md).
+//! fenestra-dc: daylight-coefficient algebra (V·T·D·s time stepping) and the matrix operations behind rmtxop.
+
+pub mod ops;
+pub mod timestep;

@@ -1,0 +1,1 @@
+//! Matrix operations for rmtxop (being written).

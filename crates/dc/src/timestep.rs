@@ -1,0 +1,1 @@
+//! V·T·D·s time stepping for dctimestep (being written).

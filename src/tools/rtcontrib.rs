@@ -1,0 +1,8 @@
+//! rtcontrib (being written; see the open issues).
+
+use std::process::ExitCode;
+
+/// Runs rtcontrib.
+pub fn run(_args: Vec<String>) -> anyhow::Result<ExitCode> {
+    anyhow::bail!("not implemented yet")
+}
