@@ -4,6 +4,7 @@
 
 pub mod cfmt;
 pub mod compiled;
+mod mgf;
 mod model;
 mod rad;
 pub mod transform;

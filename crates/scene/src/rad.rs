@@ -52,7 +52,17 @@ impl Parser {
         }
         let text = String::from_utf8(bytes)
             .map_err(|_| anyhow!("{path}: not a text file (invalid UTF-8)"))?;
+        if path.to_ascii_lowercase().ends_with(".mgf") {
+            return self.add_mgf(&text, path);
+        }
         self.add_str(&text, path)
+    }
+
+    /// Reads MGF text (converted to Radiance primitives as mgf2rad does); `file` names
+    /// it in locations and locates its includes.
+    pub fn add_mgf(&mut self, text: &str, file: &str) -> Result<()> {
+        let prims = crate::mgf::convert(text, file)?;
+        self.add_converted(prims)
     }
 
     /// Appends an already-resolved scene (e.g. a compiled one), shifting its modifier indices.
@@ -66,7 +76,6 @@ impl Parser {
     }
 
     /// Appends primitives produced by a converter (MGF), resolving their modifiers by name.
-    #[allow(dead_code)]
     pub(crate) fn add_converted(&mut self, prims: Vec<Primitive>) -> Result<()> {
         for mut p in prims {
             p.modifier = self.resolve_modifier(&p.modifier_name, &p.loc, &p.ptype, &p.name)?;
