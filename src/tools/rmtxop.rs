@@ -1,8 +1,272 @@
-//! rmtxop (being written; see the open issues).
+//! rmtxop: matrix format conversion, transposition, scaling, component transforms,
+//! products and sums, with Radiance's command line (options apply to the next matrix).
 
+use std::io::Write;
 use std::process::ExitCode;
 
+use anyhow::{bail, Context, Result};
+use fenestra_cli::opts::parse_real;
+use fenestra_dc::ops::{multiply_chain, Mtx, XmlPart};
+use fenestra_formats::header::Header;
+use fenestra_formats::matrix::{AsciiLayout, DataFormat, MatrixWriter, WriteOptions};
+
+const USAGE: &str =
+    "Usage: rmtxop [-v][-f{adfc}][-t][-s sf .. | -c ce ..][-rf|-rb] m1 [.+*] .. > mres";
+
+const HELP: &str = "rmtxop: matrix operations on Radiance matrices, BSDF XML files and pictures
+
+Usage: rmtxop [-v][-f{adfc}][-t][-s sf ..][-c ce ..][-rf|-rb] m1 [.+*] m2 .. > mres
+
+Options before a matrix apply to that matrix only:
+  -t           transpose it
+  -s sf ..     scale it: one factor, or one per (output) component
+  -c ce ..     component transform: N x NCOMP coefficients give N components
+               (-c 47.435 119.93 11.635 turns RGB irradiance into illuminance)
+  -rf, -rb     for an XML BSDF: front or back reflection instead of transmission
+Global options:
+  -fa -ff -fd -fc   output as ascii, float, double or RGBE (default: the first input's format)
+  -v           report each operation on stderr
+Operators between matrices (evaluated left to right):
+  .            matrix product (the default when no operator is given)
+  +            sum
+  *            element-wise product
+Inputs: a file, '-' for the standard input, '!command' for a command's output, or a .xml BSDF.
+The result goes to the standard output with the inputs' headers and this command line.
+";
+
+/// What joins a matrix to the result so far.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Op {
+    Product,
+    Sum,
+    ElemProduct,
+}
+
+/// One input with the options given before it.
+#[derive(Debug)]
+struct Input {
+    name: String,
+    op: Op,
+    transpose: bool,
+    scale: Option<Vec<f64>>,
+    cmat: Option<Vec<f64>>,
+    part: XmlPart,
+}
+
+struct Parsed {
+    verbose: bool,
+    format: Option<DataFormat>,
+    inputs: Vec<Input>,
+}
+
+fn parse(args: &[String]) -> Result<Parsed> {
+    let mut verbose = false;
+    let mut format = None;
+    let mut inputs = Vec::new();
+    let mut transpose = false;
+    let mut scale: Option<Vec<f64>> = None;
+    let mut cmat: Option<Vec<f64>> = None;
+    let mut part = XmlPart::Transmission;
+    let mut op: Option<Op> = None;
+    let mut i = 1;
+    // Numbers following -s/-c.
+    let numbers = |i: &mut usize, opt: &str| -> Result<Vec<f64>> {
+        let mut v = Vec::new();
+        while *i < args.len() {
+            match parse_real(&args[*i]) {
+                Some(x) => v.push(x),
+                None => break,
+            }
+            *i += 1;
+        }
+        if v.is_empty() {
+            bail!("option '{opt}' needs at least one number\n{USAGE}");
+        }
+        Ok(v)
+    };
+    while i < args.len() {
+        let a = args[i].as_str();
+        i += 1;
+        match a {
+            "--help" | "-help" => {
+                print!("{HELP}");
+                return Err(fenestra_cli::Exit(0).into());
+            }
+            "." | "+" | "*" => {
+                if inputs.is_empty() || op.is_some() {
+                    bail!("operator '{a}' must stand between two matrices\n{USAGE}");
+                }
+                op = Some(match a {
+                    "." => Op::Product,
+                    "+" => Op::Sum,
+                    _ => Op::ElemProduct,
+                });
+            }
+            "/" => {
+                bail!("operator '/' (element-wise division) is not supported by fenestra's rmtxop")
+            }
+            "-v" => verbose = true,
+            "-t" => transpose = !transpose,
+            "-s" => scale = Some(numbers(&mut i, a)?),
+            "-c" => cmat = Some(numbers(&mut i, a)?),
+            "-rf" => part = XmlPart::ReflectionFront,
+            "-rb" => part = XmlPart::ReflectionBack,
+            _ if a.starts_with("-f") && a.len() > 2 => {
+                format = Some(match &a[2..] {
+                    "a" => DataFormat::Ascii,
+                    "f" => DataFormat::Float,
+                    "d" => DataFormat::Double,
+                    "c" => DataFormat::Rgbe,
+                    _ => bail!(
+                        "unknown output format '{a}' (expected -fa, -ff, -fd or -fc)\n{USAGE}"
+                    ),
+                })
+            }
+            _ if a.len() > 1 && a.starts_with('-') && parse_real(a).is_none() => {
+                bail!("unknown option '{a}'\n{USAGE}")
+            }
+            _ => {
+                let this_op = if inputs.is_empty() {
+                    Op::Product
+                } else {
+                    op.unwrap_or(Op::Product)
+                };
+                inputs.push(Input {
+                    name: a.to_string(),
+                    op: this_op,
+                    transpose,
+                    scale: scale.take(),
+                    cmat: cmat.take(),
+                    part,
+                });
+                transpose = false;
+                part = XmlPart::Transmission;
+                op = None;
+            }
+        }
+    }
+    if inputs.is_empty() {
+        bail!("no input matrix\n{USAGE}");
+    }
+    if op.is_some() || transpose || scale.is_some() || cmat.is_some() {
+        bail!("operator or option after the last matrix\n{USAGE}");
+    }
+    Ok(Parsed {
+        verbose,
+        format,
+        inputs,
+    })
+}
+
+/// Loads one input and applies its own options.
+fn load(inp: &Input, verbose: bool) -> Result<Mtx> {
+    let mut m = Mtx::load(&inp.name, inp.part)?;
+    if verbose {
+        eprintln!(
+            "rmtxop: loaded {} ({}×{}, {} components)",
+            inp.name, m.nrows, m.ncols, m.ncomp
+        );
+    }
+    if inp.cmat.is_some() || inp.scale.is_some() {
+        m.transform(inp.cmat.as_deref(), inp.scale.as_deref())
+            .with_context(|| inp.name.clone())?;
+    }
+    if inp.transpose {
+        m.transpose();
+    }
+    Ok(m)
+}
+
 /// Runs rmtxop.
-pub fn run(_args: Vec<String>) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("not implemented yet")
+pub fn run(args: Vec<String>) -> Result<ExitCode> {
+    let p = parse(&args)?;
+    // Left to right; a run of products is multiplied as one chain (cheapest pair first).
+    let mut chain: Vec<(Mtx, String)> = Vec::new();
+    for inp in &p.inputs {
+        let m = load(inp, p.verbose)?;
+        if inp.op == Op::Product || chain.is_empty() {
+            chain.push((m, inp.name.clone()));
+            continue;
+        }
+        let mut acc = reduce_chain(std::mem::take(&mut chain), p.verbose)?;
+        match inp.op {
+            Op::Sum => acc
+                .add(&m)
+                .with_context(|| format!("{}: matrix sum failed", inp.name))?,
+            _ => acc
+                .elem_mul(&m)
+                .with_context(|| format!("{}: element-wise product failed", inp.name))?,
+        }
+        if p.verbose {
+            eprintln!("rmtxop: {:?} with {} done", inp.op, inp.name);
+        }
+        chain.push((acc, String::new()));
+    }
+    let m = reduce_chain(chain, p.verbose)?;
+    let format = p.format.unwrap_or(m.format);
+    if format.is_picture() && m.ncomp != 3 && m.ncomp != 1 {
+        bail!(
+            "cannot write a matrix with {} components as an RGBE picture (-fc needs 1 or 3)",
+            m.ncomp
+        );
+    }
+    let mut h = Header::radiance();
+    h.push(fenestra_cli::command_line(&args));
+    for l in &m.info {
+        h.push(l.clone());
+    }
+    let opts = WriteOptions {
+        format,
+        ascii: AsciiLayout::Rmtxop,
+        header: Some(h),
+        align_from: stdout_file_offset(),
+        ..Default::default()
+    };
+    // The whole result is in memory: nothing is written unless every input was read.
+    let stdout = std::io::stdout();
+    let lock = std::io::BufWriter::with_capacity(1 << 16, stdout.lock());
+    let mut w = MatrixWriter::new(lock, Some(m.nrows), m.ncols, m.ncomp, &opts)?;
+    let mut row = vec![0.0f64; m.row_len()];
+    for r in 0..m.nrows {
+        for (d, &s) in row.iter_mut().zip(m.row(r)) {
+            *d = s as f64;
+        }
+        w.write_row(&row)?;
+    }
+    let mut out = w.finish()?;
+    out.flush()?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Multiplies a chain of loaded matrices (a single matrix is returned as is).
+fn reduce_chain(chain: Vec<(Mtx, String)>, verbose: bool) -> Result<Mtx> {
+    let names: Vec<String> = chain.iter().map(|c| c.1.clone()).collect();
+    let mats: Vec<Mtx> = chain.into_iter().map(|c| c.0).collect();
+    if mats.len() > 1 {
+        if verbose {
+            eprintln!("rmtxop: multiplying {} matrices", mats.len());
+        }
+        let last = names.last().cloned().unwrap_or_default();
+        return multiply_chain(mats).with_context(|| format!("{last}: matrix product failed"));
+    }
+    mats.into_iter().next().context("no input matrix")
+}
+
+/// The current offset of the standard output when it is a regular file (Radiance pads
+/// binary headers so data start aligned in files, not in pipes).
+#[cfg(unix)]
+fn stdout_file_offset() -> Option<u64> {
+    use std::io::Seek;
+    use std::os::fd::AsFd;
+    let fd = std::io::stdout().as_fd().try_clone_to_owned().ok()?;
+    let mut f = std::fs::File::from(fd);
+    if !f.metadata().ok()?.is_file() {
+        return None;
+    }
+    f.stream_position().ok()
+}
+
+#[cfg(not(unix))]
+fn stdout_file_offset() -> Option<u64> {
+    None
 }

@@ -1,1 +1,403 @@
-//! Matrix operations for rmtxop (being written).
+//! Matrix operations behind rmtxop, with the numerics of Radiance 6.0a's `rmtxop`:
+//! elements are stored as `f32` (the oracle's build keeps matrix data in single precision),
+//! products and component transforms accumulate in `f64` and round once per element.
+//!
+//! A matrix carries its information-header lines (`info`): the input's lines (minus the
+//! identifier and the layout keys), plus a note per operation (`Applied scalar`,
+//! `Applied NxM component transform`, `Transposed rows and columns`) when it has any;
+//! a sum keeps the first operand's lines, a product keeps none — as Radiance's rmtxop.
+
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+use fenestra_formats::matrix::{DataFormat, MatrixReader};
+
+/// Which matrix an XML BSDF input gives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum XmlPart {
+    /// The transmission matrix (`dctimestep`'s T).
+    #[default]
+    Transmission,
+    /// Front (room-side) reflection (`-rf`).
+    ReflectionFront,
+    /// Back reflection (`-rb`).
+    ReflectionBack,
+}
+
+/// A matrix as rmtxop holds it: `data[(row·ncols + col)·ncomp + comp]` in single precision.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mtx {
+    /// Rows.
+    pub nrows: usize,
+    /// Columns.
+    pub ncols: usize,
+    /// Components per element.
+    pub ncomp: usize,
+    /// Row-major values, components interleaved.
+    pub data: Vec<f32>,
+    /// Header lines carried along.
+    pub info: Vec<String>,
+    /// Storage format of the input (the default output format).
+    pub format: DataFormat,
+}
+
+/// Whether `name` names a BSDF XML file (by its extension, as Radiance decides).
+pub fn is_xml(name: &str) -> bool {
+    !name.starts_with('!')
+        && Path::new(name)
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("xml"))
+}
+
+impl Mtx {
+    /// A zero matrix.
+    pub fn zeros(nrows: usize, ncols: usize, ncomp: usize) -> Mtx {
+        Mtx {
+            nrows,
+            ncols,
+            ncomp,
+            data: vec![0.0; nrows * ncols * ncomp],
+            info: Vec::new(),
+            format: DataFormat::Ascii,
+        }
+    }
+
+    /// Loads `name`: a BSDF XML file (`part` selects the matrix), `-` (stdin),
+    /// `!command`, or a matrix/picture file in any format Radiance writes.
+    pub fn load(name: &str, part: XmlPart) -> Result<Mtx> {
+        if is_xml(name) {
+            return Self::load_xml(name, part);
+        }
+        let r = MatrixReader::open(name)?;
+        Self::read_from(r)
+    }
+
+    /// Reads every row of `r` (memory grows with the data read, not with NROWS).
+    pub fn read_from(mut r: MatrixReader) -> Result<Mtx> {
+        let info = r.info.clone();
+        let row_len = info.row_len();
+        let mut data: Vec<f32> = Vec::new();
+        if let Some(n) = info.nrows {
+            data.reserve(n.saturating_mul(row_len).min(1 << 24));
+        }
+        let mut row = vec![0.0f64; row_len];
+        let mut nrows = 0;
+        while r.read_row(&mut row)? {
+            data.extend(row.iter().map(|&v| v as f32));
+            nrows += 1;
+        }
+        if info.nrows.is_none() && nrows == 0 {
+            bail!("{}: no data rows in matrix", r.name());
+        }
+        if r.has_trailing_data() {
+            fenestra_cli::warn(format!(
+                "{}: data beyond the {} rows of the header ignored",
+                r.name(),
+                nrows
+            ));
+        }
+        Ok(Mtx {
+            nrows,
+            ncols: info.ncols,
+            ncomp: info.ncomp,
+            data,
+            info: info.retained_header().lines,
+            format: info.format,
+        })
+    }
+
+    fn load_xml(name: &str, part: XmlPart) -> Result<Mtx> {
+        let b = fenestra_bsdf::read_file(Path::new(name))
+            .map_err(|e| anyhow::anyhow!("{e}"))
+            .with_context(|| format!("cannot load BSDF '{name}'"))?;
+        let m = match part {
+            XmlPart::Transmission => fenestra_bsdf::radiance::transmission_matrix(&b)
+                .map_err(|e| anyhow::anyhow!("{name}: {e}"))?,
+            XmlPart::ReflectionFront | XmlPart::ReflectionBack => {
+                let front = part == XmlPart::ReflectionFront;
+                fenestra_bsdf::radiance::reflection_matrix(&b, front)
+                    .map_err(|e| anyhow::anyhow!("{name}: {e}"))?
+                    .with_context(|| {
+                        format!(
+                            "{name}: no {} reflection data in BSDF",
+                            if front { "front" } else { "back" }
+                        )
+                    })?
+            }
+        };
+        let mut data = Vec::with_capacity(m.data.len() * 3);
+        for v in &m.data {
+            data.extend(v.iter().map(|&x| x as f32));
+        }
+        Ok(Mtx {
+            nrows: m.rows,
+            ncols: m.cols,
+            ncomp: 3,
+            data,
+            info: Vec::new(),
+            format: DataFormat::Ascii,
+        })
+    }
+
+    /// Values per row.
+    pub fn row_len(&self) -> usize {
+        self.ncols * self.ncomp
+    }
+
+    /// Row `r`'s values.
+    pub fn row(&self, r: usize) -> &[f32] {
+        let n = self.row_len();
+        &self.data[r * n..(r + 1) * n]
+    }
+
+    /// Appends an operation note to the header lines, when there are any (as Radiance).
+    pub fn note(&mut self, line: &str) {
+        if !self.info.is_empty() {
+            self.info.push(line.to_string());
+        }
+    }
+
+    /// Swaps rows and columns (components stay with their element).
+    pub fn transpose(&mut self) {
+        let nc = self.ncomp;
+        let mut data = vec![0.0f32; self.data.len()];
+        for r in 0..self.nrows {
+            for c in 0..self.ncols {
+                let s = (r * self.ncols + c) * nc;
+                let d = (c * self.nrows + r) * nc;
+                data[d..d + nc].copy_from_slice(&self.data[s..s + nc]);
+            }
+        }
+        self.data = data;
+        std::mem::swap(&mut self.nrows, &mut self.ncols);
+        self.note("Transposed rows and columns");
+    }
+
+    /// Applies a component transform and/or scale factors, as rmtxop's `-c` and `-s`:
+    /// `cmat` holds `nout × ncomp` coefficients (row per output component); `scale` holds
+    /// one factor or one per output component, applied after the transform.
+    pub fn transform(&mut self, cmat: Option<&[f64]>, scale: Option<&[f64]>) -> Result<()> {
+        let nin = self.ncomp;
+        let nout = match cmat {
+            Some(c) => {
+                if c.is_empty() || c.len() % nin != 0 {
+                    bail!(
+                        "-c needs N × {nin} coefficients for a matrix with {nin} components, got {}",
+                        c.len()
+                    );
+                }
+                c.len() / nin
+            }
+            None => nin,
+        };
+        let sf: Option<Vec<f64>> = match scale {
+            None => None,
+            Some(s) if s.len() == 1 => Some(vec![s[0]; nout]),
+            Some(s) if s.len() == nout => Some(s.to_vec()),
+            Some(s) => bail!(
+                "-s needs one factor or {nout} (one per component), got {}",
+                s.len()
+            ),
+        };
+        match cmat {
+            Some(c) => {
+                // Fold the scale factors into the coefficients.
+                let mut m = c.to_vec();
+                if let Some(sf) = &sf {
+                    for (k, row) in m.chunks_exact_mut(nin).enumerate() {
+                        for v in row {
+                            *v *= sf[k];
+                        }
+                    }
+                }
+                let nel = self.nrows * self.ncols;
+                let mut out = Vec::with_capacity(nel * nout);
+                for el in self.data.chunks_exact(nin) {
+                    for row in m.chunks_exact(nin) {
+                        // Radiance sums the last component first.
+                        let mut d = 0.0f64;
+                        for (a, &b) in row.iter().zip(el).rev() {
+                            d += a * b as f64;
+                        }
+                        out.push(d as f32);
+                    }
+                }
+                self.data = out;
+                self.ncomp = nout;
+                self.note(&format!("Applied {nout}x{nin} component transform"));
+            }
+            None => {
+                if let Some(sf) = &sf {
+                    // A plain scale is a single-precision product, as in Radiance.
+                    let sf: Vec<f32> = sf.iter().map(|&s| s as f32).collect();
+                    for el in self.data.chunks_exact_mut(nin) {
+                        for (v, &s) in el.iter_mut().zip(&sf) {
+                            *v *= s;
+                        }
+                    }
+                    self.note("Applied scalar");
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Adds `other` element by element (same shape and components required).
+    pub fn add(&mut self, other: &Mtx) -> Result<()> {
+        self.same_shape(other, "sum")?;
+        for (a, &b) in self.data.iter_mut().zip(&other.data) {
+            *a += b;
+        }
+        Ok(())
+    }
+
+    /// Multiplies element by element (`*`).
+    pub fn elem_mul(&mut self, other: &Mtx) -> Result<()> {
+        self.same_shape(other, "element-wise product")?;
+        for (a, &b) in self.data.iter_mut().zip(&other.data) {
+            *a = (*a as f64 * b as f64) as f32;
+        }
+        Ok(())
+    }
+
+    fn same_shape(&self, other: &Mtx, what: &str) -> Result<()> {
+        if (self.nrows, self.ncols, self.ncomp) != (other.nrows, other.ncols, other.ncomp) {
+            bail!(
+                "{what} of mismatched matrices: {}×{}×{} and {}×{}×{} (rows × columns × components)",
+                self.nrows,
+                self.ncols,
+                self.ncomp,
+                other.nrows,
+                other.ncols,
+                other.ncomp
+            );
+        }
+        Ok(())
+    }
+
+    /// The matrix product `self · other`, component by component (both need the same
+    /// number of components); sums accumulate in double precision.
+    pub fn multiply(&self, other: &Mtx) -> Result<Mtx> {
+        self.multiply_check(other)?;
+        let (n, m, p, nc) = (self.nrows, self.ncols, other.ncols, self.ncomp);
+        let mut out = Mtx::zeros(n, p, nc);
+        out.format = self.format;
+        let mut acc = vec![0.0f64; p * nc];
+        for i in 0..n {
+            acc.iter_mut().for_each(|v| *v = 0.0);
+            let arow = self.row(i);
+            for h in 0..m {
+                let a = &arow[h * nc..(h + 1) * nc];
+                let brow = other.row(h);
+                for (d, b) in acc.chunks_exact_mut(nc).zip(brow.chunks_exact(nc)) {
+                    for k in 0..nc {
+                        d[k] += a[k] as f64 * b[k] as f64;
+                    }
+                }
+            }
+            let orow = &mut out.data[i * p * nc..(i + 1) * p * nc];
+            for (o, &v) in orow.iter_mut().zip(&acc) {
+                *o = v as f32;
+            }
+        }
+        Ok(out)
+    }
+
+    fn multiply_check(&self, other: &Mtx) -> Result<()> {
+        if self.ncols != other.nrows {
+            bail!(
+                "matrix product of mismatched sizes: {}×{} times {}×{} (columns of the first must equal rows of the second)",
+                self.nrows,
+                self.ncols,
+                other.nrows,
+                other.ncols
+            );
+        }
+        if self.ncomp != other.ncomp {
+            bail!(
+                "matrix product of matrices with {} and {} components",
+                self.ncomp,
+                other.ncomp
+            );
+        }
+        Ok(())
+    }
+}
+
+/// Multiplies a chain of matrices, choosing the order as Radiance's rmtxop does: the
+/// adjacent pair cheapest to multiply (rows × inner × columns) goes first, repeatedly
+/// (the order changes the single-precision rounding of the result).
+pub fn multiply_chain(mut chain: Vec<Mtx>) -> Result<Mtx> {
+    for w in chain.windows(2) {
+        if w[0].ncols != w[1].nrows || w[0].ncomp != w[1].ncomp {
+            // Report the first mismatch in command-line order.
+            w[0].multiply_check(&w[1])?;
+        }
+    }
+    while chain.len() > 1 {
+        let mut best = 0;
+        let mut best_cost = u128::MAX;
+        for (i, w) in chain.windows(2).enumerate() {
+            let cost = w[0].nrows as u128 * w[0].ncols as u128 * w[1].ncols as u128;
+            if cost < best_cost {
+                best_cost = cost;
+                best = i;
+            }
+        }
+        let b = chain.remove(best + 1);
+        let p = chain[best].multiply(&b)?;
+        chain[best] = p;
+    }
+    chain.pop().context("empty matrix chain")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn m(nrows: usize, ncols: usize, ncomp: usize, v: &[f32]) -> Mtx {
+        Mtx {
+            nrows,
+            ncols,
+            ncomp,
+            data: v.to_vec(),
+            info: vec!["x".into()],
+            format: DataFormat::Ascii,
+        }
+    }
+
+    #[test]
+    fn transpose_moves_elements_with_components() {
+        let mut a = m(1, 2, 2, &[1., 2., 3., 4.]);
+        a.transpose();
+        assert_eq!((a.nrows, a.ncols), (2, 1));
+        assert_eq!(a.data, vec![1., 2., 3., 4.]);
+        assert_eq!(a.info.last().unwrap(), "Transposed rows and columns");
+    }
+
+    #[test]
+    fn component_transform_then_scale() {
+        let mut a = m(1, 1, 3, &[1., 2., 3.]);
+        a.transform(Some(&[1., 1., 1., 1., 0., 0.]), Some(&[2., 3.]))
+            .unwrap();
+        assert_eq!(a.ncomp, 2);
+        assert_eq!(a.data, vec![12., 3.]);
+        let mut b = m(1, 1, 3, &[1., 2., 3.]);
+        assert!(b.transform(Some(&[1., 1.]), None).is_err());
+        assert!(b.transform(None, Some(&[1., 2.])).is_err());
+    }
+
+    #[test]
+    fn product_and_sum() {
+        let a = m(1, 2, 1, &[1., 2.]);
+        let b = m(2, 1, 1, &[3., 4.]);
+        let p = a.multiply(&b).unwrap();
+        assert_eq!(p.data, vec![11.]);
+        assert!(p.info.is_empty());
+        assert!(a.multiply(&a).is_err());
+        let mut s = a.clone();
+        s.add(&a).unwrap();
+        assert_eq!(s.data, vec![2., 4.]);
+        assert!(s.add(&b).is_err());
+    }
+}
