@@ -1,31 +1,104 @@
-//! Patterns. Until fenestra's .cal engine is wired in, the two sky functions every
-//! daylight workflow uses are evaluated natively (through fenestra-sky): `brightfunc`
-//! with `skybr skybright.cal` (gensky) and `skybright perezlum.cal` (gendaylit).
-//! Any other pattern is a clear error naming it.
+//! Patterns: `brightfunc` and `colorfunc` evaluated with fenestra's .cal engine
+//! (`lib/rayinit.cal` preloaded, as Radiance's renderers do), with the ray variables
+//! `Dx Dy Dz Nx Ny Nz Px Py Pz T Ts Rdot …` bound per evaluation and `arg(n)` the
+//! primitive's real arguments. gensky's `skybr skybright.cal` and gendaylit's
+//! `skybright perezlum.cal` — the sky functions every daylight run evaluates for each
+//! sky ray — take a native fast path (fenestra-sky's models of the same files; the
+//! two agree to 1e-12, see tests/sky_cal_files.rs).
 
-use anyhow::{bail, Result};
+use std::sync::Arc;
+
+use anyhow::{anyhow, bail, Result};
+use fenestra_calc::{Compiled, ExprId, Program, VarId};
 use fenestra_scene::Scene;
 use fenestra_sky::cie::SkyBright;
 use fenestra_sky::skyvec::PerezLum;
 use glam::DVec3;
 
+/// Where a pattern is evaluated: the ray and the surface point it reached.
+#[derive(Debug, Clone, Copy)]
+pub struct PatternInput {
+    /// Unit ray direction (`Dx Dy Dz`).
+    pub dir: DVec3,
+    /// Hit point (`Px Py Pz`); the ray origin for a distant source.
+    pub point: DVec3,
+    /// Unit surface normal (`Nx Ny Nz`); `-dir` for a distant source.
+    pub normal: DVec3,
+    /// Distance along the ray (`T`, `Ts`).
+    pub dist: f64,
+}
+
+/// The names the host sets before each evaluation, in this order.
+const HOST_VARS: [&str; 28] = [
+    "Dx", "Dy", "Dz", "Nx", "Ny", "Nz", "Px", "Py", "Pz", "T", "Ts", "Rdot", "NxP", "NyP", "NzP",
+    "RdotP", "S", "Ix", "Iy", "Iz", "Jx", "Jy", "Jz", "Kx", "Ky", "Kz", "Tx", "Ty",
+];
+
+/// A pattern compiled from a .cal file.
+pub struct CalPattern {
+    exe: Compiled,
+    vars: Vec<VarId>,
+    exprs: Vec<ExprId>,
+    fargs: Vec<f64>,
+}
+
+impl std::fmt::Debug for CalPattern {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CalPattern")
+            .field("exprs", &self.exprs.len())
+            .field("fargs", &self.fargs)
+            .finish()
+    }
+}
+
+impl CalPattern {
+    fn values(q: &PatternInput) -> [f64; 28] {
+        let (d, p, n) = (q.dir, q.point, q.normal);
+        let rdot = -d.dot(n);
+        [
+            d.x, d.y, d.z, n.x, n.y, n.z, p.x, p.y, p.z, q.dist, q.dist, rdot, n.x, n.y, n.z, rdot,
+            1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0,
+        ]
+    }
+
+    fn eval(&self, q: &PatternInput) -> Result<DVec3> {
+        let mut st = self.exe.state();
+        st.set_all(&self.vars, &Self::values(q));
+        st.set_fargs(&self.fargs);
+        let mut out = [0.0; 3];
+        for (k, e) in self.exprs.iter().enumerate() {
+            out[k] = self
+                .exe
+                .eval_expr(&mut st, *e)
+                .map_err(|e| anyhow!("{e}"))?;
+        }
+        if self.exprs.len() == 1 {
+            out = [out[0]; 3];
+        }
+        Ok(DVec3::from_array(out))
+    }
+}
+
 /// A compiled pattern.
 #[derive(Debug, Clone)]
 pub enum Pattern {
-    /// gensky's CIE sky (`skybright.cal`).
+    /// gensky's CIE sky (`skybright.cal`), evaluated natively.
     Cie(SkyBright),
-    /// gendaylit's Perez sky (`perezlum.cal`).
+    /// gendaylit's Perez sky (`perezlum.cal`), evaluated natively.
     Perez(PerezLum),
+    /// Any other `brightfunc`/`colorfunc`, through the .cal engine.
+    Cal(Arc<CalPattern>),
 }
 
 impl Pattern {
-    /// Value for a ray travelling along unit `dir` (grey patterns give equal channels).
-    pub fn eval(&self, dir: DVec3) -> DVec3 {
-        let d = dir.to_array();
-        DVec3::splat(match self {
-            Pattern::Cie(s) => s.radiance(d),
-            Pattern::Perez(p) => p.radiance(d),
-        })
+    /// Value for a ray (grey patterns give equal channels). A .cal evaluation error
+    /// (caught at scene load on a trial ray, so rare here) gives zero.
+    pub fn eval(&self, q: &PatternInput) -> DVec3 {
+        match self {
+            Pattern::Cie(s) => DVec3::splat(s.radiance(q.dir.to_array())),
+            Pattern::Perez(p) => DVec3::splat(p.radiance(q.dir.to_array())),
+            Pattern::Cal(c) => c.eval(q).unwrap_or(DVec3::ZERO),
+        }
     }
 }
 
@@ -39,28 +112,60 @@ pub fn compile(scene: &Scene, k: usize, user: &str) -> Result<Pattern> {
             if let Some(s) = SkyBright::from_args(&q.rargs) {
                 return Ok(Pattern::Cie(s));
             }
-            bail!(
-                "{}: brightfunc '{}': bad arguments for skybright.cal",
-                q.loc,
-                q.name
-            );
         }
         if func == "skybright" && cal == "perezlum.cal" {
             if let Some(p) = PerezLum::from_args(&q.rargs) {
                 return Ok(Pattern::Perez(p));
             }
-            bail!(
-                "{}: brightfunc '{}': perezlum.cal needs 10 real arguments",
-                q.loc,
-                q.name
-            );
         }
     }
-    bail!(
-        "{}: {} '{}' (modifying '{user}'): fenestra's ray tracer evaluates only the sky patterns \
-         'skybr skybright.cal' and 'skybright perezlum.cal' in this build; other patterns and textures are not supported",
-        q.loc,
-        q.ptype,
-        q.name
-    )
+    let what = format!("{}: {} '{}' (modifying '{user}')", q.loc, q.ptype, q.name);
+    let nexpr = match q.ptype.as_str() {
+        "brightfunc" => 1,
+        "colorfunc" => 3,
+        other => bail!(
+            "{what}: fenestra's ray tracer evaluates brightfunc and colorfunc patterns; '{other}' is not supported yet"
+        ),
+    };
+    if q.sargs.len() < nexpr + 1 {
+        bail!(
+            "{what}: needs {} string arguments (function{} and .cal file)",
+            nexpr + 1,
+            if nexpr > 1 { "s" } else { "" }
+        );
+    }
+    if q.sargs.len() > nexpr + 1 {
+        bail!("{what}: transform arguments on patterns are not supported yet");
+    }
+    let mut p = Program::for_renderer();
+    let init =
+        fenestra_cli::raypath::find_or_err("rayinit.cal").map_err(|e| anyhow!("{what}: {e:#}"))?;
+    p.load_file(&init).map_err(|e| anyhow!("{what}: {e}"))?;
+    let cal = &q.sargs[nexpr];
+    if cal != "." {
+        let path = fenestra_cli::raypath::find_or_err(cal).map_err(|e| anyhow!("{what}: {e:#}"))?;
+        p.load_file(&path).map_err(|e| anyhow!("{what}: {e}"))?;
+    }
+    let vars = p.bind_vars(&HOST_VARS);
+    let mut exprs = Vec::new();
+    for e in &q.sargs[..nexpr] {
+        exprs.push(p.add_expr(&q.name, e).map_err(|e| anyhow!("{what}: {e}"))?);
+    }
+    let exe = p.compile().map_err(|e| anyhow!("{what}: {e}"))?;
+    let cp = CalPattern {
+        exe,
+        vars,
+        exprs,
+        fargs: q.rargs.clone(),
+    };
+    // A trial evaluation catches undefined names and wrong argument counts now, with a
+    // message, instead of silently zero values later.
+    let trial = PatternInput {
+        dir: DVec3::new(0.3, 0.4, 0.866_025_403_784_438_6),
+        point: DVec3::ZERO,
+        normal: DVec3::new(0.0, 0.0, -1.0),
+        dist: 1.0,
+    };
+    cp.eval(&trial).map_err(|e| anyhow!("{what}: {e}"))?;
+    Ok(Pattern::Cal(Arc::new(cp)))
 }

@@ -15,6 +15,7 @@ use glam::DVec3;
 use crate::bvh::Accel;
 use crate::material::{compile, is_pattern, LightKind, Material, FTINY};
 use crate::options::TraceOptions;
+use crate::pattern::PatternInput;
 use crate::polygon::Polygon;
 use crate::rng::Rng;
 use crate::shape::Shape;
@@ -753,7 +754,15 @@ impl Tracer {
             } => (
                 self.shade_normal(
                     r,
-                    *c0 * self.pattern(m, r.dir),
+                    *c0 * self.pattern(
+                        m,
+                        &PatternInput {
+                            dir: r.dir,
+                            point: p,
+                            normal: n,
+                            dist: t,
+                        },
+                    ),
                     *spec,
                     *rough,
                     *trans,
@@ -837,14 +846,24 @@ impl Tracer {
                 return (DVec3::ZERO, false);
             }
         }
-        (*color * self.pattern(m, r.dir), false)
+        let normal = match shape {
+            Some(s) => self.accel.shapes[s].normal(p),
+            None => -r.dir,
+        };
+        let q = PatternInput {
+            dir: r.dir,
+            point: p,
+            normal,
+            dist: t,
+        };
+        (*color * self.pattern(m, &q), false)
     }
 
     /// Product of the patterns on material `m` for a ray going along `dir`.
-    fn pattern(&self, m: usize, dir: DVec3) -> DVec3 {
+    fn pattern(&self, m: usize, q: &PatternInput) -> DVec3 {
         match self.patterns.get(&m) {
             None => DVec3::ONE,
-            Some(ps) => ps.iter().fold(DVec3::ONE, |acc, p| acc * p.eval(dir)),
+            Some(ps) => ps.iter().fold(DVec3::ONE, |acc, p| acc * p.eval(q)),
         }
     }
 

@@ -1,0 +1,124 @@
+//! Patterns through the .cal engine: rtrace with brightfunc/colorfunc patterns defined in
+//! a user's .cal file, against the reference rtrace.
+
+mod common;
+
+use std::io::Write;
+use std::process::{Command, Stdio};
+
+fn run(mut cmd: Command, input: &str) -> std::process::Output {
+    let mut child = cmd
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let _ = child.stdin.take().unwrap().write_all(input.as_bytes());
+    child.wait_with_output().unwrap()
+}
+
+const CAL: &str = "{ test patterns }
+grad = 1 + Dz*Dz + A1*Dx;
+band(x) = if(sin(x*A2), 1, .25);
+rr = .5 + .5*band(Px);  gg = .5 + .5*band(Py);  bb = and(Pz + 1, 1 - Pz);
+";
+
+const SCENE: &str = "
+void brightfunc skypat 2 grad pats.cal 0 1 .5
+skypat glow skyglow 0 0 4 2 2 2 0
+skyglow source sky 0 0 4 0 0 1 180
+
+void colorfunc stripes 4 rr gg bb pats.cal 0 2 0 7
+stripes plastic floor_mat 0 0 5 .6 .5 .4 0 0
+floor_mat polygon floor 0 0 12  -5 -5 0  5 -5 0  5 5 0  -5 5 0
+
+void light sunlit 0 0 3 1e5 1e5 1e5
+sunlit source sun 0 0 4 .3 .2 1 .5
+";
+
+/// Rays: some straight at the (patterned) sky, some down at the (patterned) floor.
+fn rays() -> String {
+    let mut s = String::new();
+    for k in 0..24 {
+        let a = k as f64 * 0.26;
+        s.push_str(&format!(
+            "0 0 1 {} {} {}\n",
+            a.cos() * 0.6,
+            a.sin() * 0.6,
+            0.8
+        ));
+        s.push_str(&format!(
+            "{} {} 2 {} {} -1\n",
+            a.cos() * 0.3,
+            a.sin(),
+            a.sin() * 0.4,
+            a.cos() * 0.2
+        ));
+    }
+    s
+}
+
+fn values(out: &[u8]) -> Vec<f64> {
+    String::from_utf8_lossy(out)
+        .split_whitespace()
+        .map(|w| w.parse().unwrap())
+        .collect()
+}
+
+#[test]
+fn oracle_cal_patterns_match_rtrace() {
+    let Some(oracle) = common::oracle() else {
+        return;
+    };
+    let dir = common::scratch("patterns");
+    std::fs::write(dir.join("pats.cal"), CAL).unwrap();
+    std::fs::write(dir.join("scene.rad"), SCENE).unwrap();
+    // -ab 0 and no jitter (-dj 0, -ds 0): direct light and sky values are deterministic.
+    let opts = ["-h", "-ab", "0", "-dj", "0", "-ds", "0", "-u-"];
+    let mut c = oracle.command("oconv");
+    c.arg("scene.rad").current_dir(&dir);
+    let oct = common::run_ok(&mut c);
+    std::fs::write(dir.join("scene.oct"), oct).unwrap();
+    let mut theirs = oracle.command("rtrace");
+    theirs.args(opts).arg("scene.oct").current_dir(&dir);
+    let t = run(theirs, &rays());
+    assert!(t.status.success(), "{}", String::from_utf8_lossy(&t.stderr));
+    let mut ours = common::fenestra("rtrace");
+    ours.args(opts).arg("scene.rad").current_dir(&dir);
+    let o = run(ours, &rays());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (t, o) = (values(&t.stdout), values(&o.stdout));
+    assert_eq!(t.len(), o.len());
+    assert!(t.iter().any(|v| *v > 0.0));
+    for (k, (a, b)) in t.iter().zip(&o).enumerate() {
+        // rtrace prints 6 significant digits and keeps colours in single precision.
+        assert!(
+            (a - b).abs() <= 2e-5 * a.abs().max(1e-3),
+            "value {k}: oracle {a} ours {b}"
+        );
+    }
+}
+
+#[test]
+fn pattern_errors_are_clear() {
+    let dir = common::scratch("patterns_bad");
+    std::fs::write(dir.join("p.cal"), "f = nosuchname * 2;\n").unwrap();
+    let cases = [
+        ("void brightfunc b 2 f p.cal 0 0\nb glow g 0 0 4 1 1 1 0\ng source s 0 0 4 0 0 1 180\n", "nosuchname"),
+        ("void brightfunc b 2 f missing.cal 0 0\nb glow g 0 0 4 1 1 1 0\ng source s 0 0 4 0 0 1 180\n", "missing.cal"),
+        ("void brightfunc b 4 f p.cal -rz 90 0 0\nb glow g 0 0 4 1 1 1 0\ng source s 0 0 4 0 0 1 180\n", "transform"),
+    ];
+    for (k, (text, what)) in cases.iter().enumerate() {
+        std::fs::write(dir.join("s.rad"), text).unwrap();
+        let mut c = common::fenestra("rtrace");
+        c.args(["-h", "s.rad"]).current_dir(&dir);
+        let o = run(c, "0 0 0 0 0 1\n");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "case {k}");
+        assert!(o.stdout.is_empty(), "case {k}");
+        assert!(
+            err.contains(what) && err.contains("s.rad:1"),
+            "case {k}: {err}"
+        );
+    }
+}
