@@ -83,7 +83,8 @@ fn real(w: &str) -> Result<f64> {
     fenestra_cli::opts::parse_real(w).ok_or_else(|| anyhow!("'{w}' is not a number"))
 }
 
-/// The sky function of a description as a Rust model.
+/// The sky function of a description: gensky's and gendaylit's natively, any other
+/// brightfunc through the .cal engine.
 fn sky_function(p: &Prim) -> Result<Box<dyn Fn([f64; 3]) -> f64 + Sync>> {
     let a: Vec<f64> = p.rargs.iter().map(|w| real(w)).collect::<Result<_>>()?;
     if p.ptype != "brightfunc" {
@@ -114,9 +115,23 @@ fn sky_function(p: &Prim) -> Result<Box<dyn Fn([f64; 3]) -> f64 + Sync>> {
                 .ok_or_else(|| anyhow!("skyfunc: perezlum.cal needs 10 real arguments"))?;
             Ok(Box::new(move |d| m.radiance(d)))
         }
-        _ => bail!(
-            "skyfunc: function '{func}' of '{file}' is not supported by fenestra genskyvec (skybr of skybright.cal and skybright of perezlum.cal are)"
-        ),
+        _ => {
+            // Any other sky function: through the .cal engine, as Radiance's genskyvec
+            // has rtrace evaluate it (rayinit.cal first; a distant glow: N = -D).
+            let cal = p.sargs[1].clone();
+            let pat = fenestra_trace::pattern::CalPattern::new(&[func], &cal, &a, &p.name)
+                .with_context(|| format!("skyfunc '{}' ({cal})", p.name))?;
+            Ok(Box::new(move |d| {
+                let dir = glam::DVec3::from_array(d);
+                let q = fenestra_trace::pattern::PatternInput {
+                    dir,
+                    point: glam::DVec3::ZERO,
+                    normal: -dir,
+                    dist: 1e10,
+                };
+                pat.value(&q).map(|v| v.x).unwrap_or(0.0)
+            }))
+        }
     }
 }
 

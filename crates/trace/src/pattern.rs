@@ -52,6 +52,44 @@ impl std::fmt::Debug for CalPattern {
 }
 
 impl CalPattern {
+    /// Compiles expressions `exprs` (1 for brightfunc, 3 for colorfunc) over .cal file
+    /// `cal` (`.` for none, found through RAYPATH), with `rayinit.cal` loaded first and
+    /// `fargs` as `arg(n)`. A trial evaluation reports undefined names now.
+    pub fn new(exprs: &[String], cal: &str, fargs: &[f64], label: &str) -> Result<CalPattern> {
+        let mut p = Program::for_renderer();
+        let init = fenestra_cli::raypath::find_or_err("rayinit.cal")?;
+        p.load_file(&init).map_err(|e| anyhow!("{e}"))?;
+        if cal != "." {
+            let path = fenestra_cli::raypath::find_or_err(cal)?;
+            p.load_file(&path).map_err(|e| anyhow!("{e}"))?;
+        }
+        let vars = p.bind_vars(&HOST_VARS);
+        let mut ids = Vec::new();
+        for e in exprs {
+            ids.push(p.add_expr(label, e).map_err(|e| anyhow!("{e}"))?);
+        }
+        let exe = p.compile().map_err(|e| anyhow!("{e}"))?;
+        let cp = CalPattern {
+            exe,
+            vars,
+            exprs: ids,
+            fargs: fargs.to_vec(),
+        };
+        let trial = PatternInput {
+            dir: DVec3::new(0.3, 0.4, 0.866_025_403_784_438_6),
+            point: DVec3::ZERO,
+            normal: DVec3::new(0.0, 0.0, -1.0),
+            dist: 1.0,
+        };
+        cp.eval(&trial)?;
+        Ok(cp)
+    }
+
+    /// The value (RGB; a brightfunc gives three equal channels) for a ray.
+    pub fn value(&self, q: &PatternInput) -> Result<DVec3> {
+        self.eval(q)
+    }
+
     fn values(q: &PatternInput) -> [f64; 28] {
         let (d, p, n) = (q.dir, q.point, q.normal);
         let rdot = -d.dot(n);
@@ -137,35 +175,7 @@ pub fn compile(scene: &Scene, k: usize, user: &str) -> Result<Pattern> {
     if q.sargs.len() > nexpr + 1 {
         bail!("{what}: transform arguments on patterns are not supported yet");
     }
-    let mut p = Program::for_renderer();
-    let init =
-        fenestra_cli::raypath::find_or_err("rayinit.cal").map_err(|e| anyhow!("{what}: {e:#}"))?;
-    p.load_file(&init).map_err(|e| anyhow!("{what}: {e}"))?;
-    let cal = &q.sargs[nexpr];
-    if cal != "." {
-        let path = fenestra_cli::raypath::find_or_err(cal).map_err(|e| anyhow!("{what}: {e:#}"))?;
-        p.load_file(&path).map_err(|e| anyhow!("{what}: {e}"))?;
-    }
-    let vars = p.bind_vars(&HOST_VARS);
-    let mut exprs = Vec::new();
-    for e in &q.sargs[..nexpr] {
-        exprs.push(p.add_expr(&q.name, e).map_err(|e| anyhow!("{what}: {e}"))?);
-    }
-    let exe = p.compile().map_err(|e| anyhow!("{what}: {e}"))?;
-    let cp = CalPattern {
-        exe,
-        vars,
-        exprs,
-        fargs: q.rargs.clone(),
-    };
-    // A trial evaluation catches undefined names and wrong argument counts now, with a
-    // message, instead of silently zero values later.
-    let trial = PatternInput {
-        dir: DVec3::new(0.3, 0.4, 0.866_025_403_784_438_6),
-        point: DVec3::ZERO,
-        normal: DVec3::new(0.0, 0.0, -1.0),
-        dist: 1.0,
-    };
-    cp.eval(&trial).map_err(|e| anyhow!("{what}: {e}"))?;
+    let cp = CalPattern::new(&q.sargs[..nexpr], &q.sargs[nexpr], &q.rargs, &q.name)
+        .map_err(|e| anyhow!("{what}: {e:#}"))?;
     Ok(Pattern::Cal(Arc::new(cp)))
 }
