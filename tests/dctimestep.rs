@@ -300,7 +300,7 @@ fn oracle_headers_and_values_match() {
                 (ha, ba, hb, bb)
             };
             assert_eq!(ha, hb, "{args:?}: header");
-            let (va, vb) = if opts.iter().any(|x| *x == "-of") {
+            let (va, vb) = if opts.contains(&"-of") {
                 (floats(&ba), floats(&bb))
             } else if opts.contains(&"-od") {
                 let d = |b: &[u8]| -> Vec<f64> {
