@@ -90,11 +90,13 @@ impl Mtx {
             bail!("{}: no data rows in matrix", r.name());
         }
         if r.has_trailing_data() {
-            fenestra_cli::warn(format!(
-                "{}: data beyond the {} rows of the header ignored",
+            bail!(
+                "{}: more data than the header's NROWS={} NCOLS={} NCOMP={} describe (wrong header?)",
                 r.name(),
-                nrows
-            ));
+                nrows,
+                info.ncols,
+                info.ncomp
+            );
         }
         Ok(Mtx {
             nrows,

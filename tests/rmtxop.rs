@@ -1,0 +1,315 @@
+//! rmtxop from the command line, against stored oracle outputs and the oracle's rmtxop.
+
+mod common;
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+fn words(s: &str) -> Vec<String> {
+    s.split_whitespace().map(str::to_string).collect()
+}
+
+fn tp() -> PathBuf {
+    common::fixture("threephase")
+}
+
+fn run(mut c: Command, dir: &Path, args: &[String]) -> Output {
+    c.current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run {c:?}: {e}"))
+}
+
+/// Compares our stdout and exit status with the oracle's for `args` run in `dir`.
+fn same_as_oracle(o: &common::Oracle, dir: &Path, args: &str) {
+    let a = words(args);
+    let theirs = run(o.command("rmtxop"), dir, &a);
+    let ours = run(common::fenestra("rmtxop"), dir, &a);
+    assert_eq!(
+        theirs.status.success(),
+        ours.status.success(),
+        "exit status differs for rmtxop {args}: {}",
+        String::from_utf8_lossy(&ours.stderr)
+    );
+    if theirs.stdout != ours.stdout {
+        let pos = theirs
+            .stdout
+            .iter()
+            .zip(&ours.stdout)
+            .position(|(x, y)| x != y)
+            .unwrap_or(theirs.stdout.len().min(ours.stdout.len()));
+        panic!(
+            "rmtxop {args}: output differs from the oracle's at byte {pos} (lengths {} and {})",
+            theirs.stdout.len(),
+            ours.stdout.len()
+        );
+    }
+}
+
+/// The stored oracle outputs `ill_*.dat` (made with `rmtxop -fa -c 47.435 119.93 11.635
+/// res_*.dat` in the reference folder) are reproduced byte for byte, header included;
+/// no oracle needed.
+#[test]
+fn lux_conversion_reproduces_stored_oracle_output() {
+    for (res, ill) in [
+        ("res_t1_mar21_1000_clear.dat", "ill_t1_mar21_1000_clear.dat"),
+        (
+            "res_t4_sep21_1200_overcast.dat",
+            "ill_t4_sep21_1200_overcast.dat",
+        ),
+        (
+            "res_rflux_t2_jun21_1500_clear.dat",
+            "ill_rflux_t2_jun21_1500_clear.dat",
+        ),
+        ("annual_res.dat", "annual_ill.dat"),
+    ] {
+        let out = run(
+            common::fenestra("rmtxop"),
+            &tp(),
+            &words(&format!("-fa -c 47.435 119.93 11.635 {res}")),
+        );
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let want = std::fs::read(common::fixture(&format!("matrices/{ill}"))).unwrap();
+        assert!(out.stdout == want, "{ill} not reproduced");
+    }
+}
+
+/// The exact pipe of examples/three-phase/run.sh: data from stdin (`-`).
+#[test]
+fn stdin_pipe_form_works() {
+    let mut child = common::fenestra("rmtxop")
+        .args(words("-fa -c 47.435 119.93 11.635 -"))
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let data = std::fs::read(tp().join("res_t1_mar21_1000_clear.dat")).unwrap();
+    child.stdin.take().unwrap().write_all(&data).unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert!(out.status.success());
+    let want = std::fs::read(common::fixture("matrices/ill_t1_mar21_1000_clear.dat")).unwrap();
+    let want = String::from_utf8(want)
+        .unwrap()
+        .replace("res_t1_mar21_1000_clear.dat\n", "-\n");
+    assert_eq!(String::from_utf8(out.stdout).unwrap(), want);
+}
+
+/// Transposing twice gives the input back; the header notes the operation.
+#[test]
+fn transpose_twice_is_identity() {
+    let dir = common::scratch("rmtxop-tt");
+    let once = run(
+        common::fenestra("rmtxop"),
+        &tp(),
+        &words("-ff -t test.m1.smx"),
+    );
+    assert!(once.status.success());
+    std::fs::write(dir.join("t.f"), &once.stdout).unwrap();
+    let text = String::from_utf8_lossy(&once.stdout[..400]).to_string();
+    assert!(
+        text.contains("NROWS=56") && text.contains("NCOLS=146"),
+        "{text}"
+    );
+    let back = run(common::fenestra("rmtxop"), &dir, &words("-fa -t t.f"));
+    let orig = run(common::fenestra("rmtxop"), &tp(), &words("-fa test.m1.smx"));
+    let data = |o: &Output| {
+        let s = String::from_utf8_lossy(&o.stdout).to_string();
+        s[s.find("\n\n").unwrap()..].to_string()
+    };
+    assert_eq!(data(&back), data(&orig));
+}
+
+/// Format conversions of every reference matrix with a header (NROWS present: the
+/// oracle's rmtxop cannot read matrices without it) are byte-identical with the
+/// oracle's, ascii and binary alike: same single-precision storage, same printing.
+#[test]
+fn oracle_format_conversions_are_byte_identical() {
+    let Some(o) = common::oracle() else { return };
+    let mut files: Vec<(PathBuf, String)> = Vec::new();
+    for sub in ["threephase", "sky"] {
+        let dir = common::fixture(sub);
+        let mut names: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .filter_map(|e| e.ok())
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| {
+                let p = dir.join(n);
+                let head = std::fs::read(&p).map(|b| b[..b.len().min(2000)].to_vec());
+                head.is_ok_and(|h| {
+                    h.starts_with(b"#?RADIANCE") && String::from_utf8_lossy(&h).contains("NROWS=")
+                })
+            })
+            .collect();
+        names.sort();
+        files.extend(names.into_iter().map(|n| (dir.clone(), n)));
+    }
+    assert!(files.len() >= 20, "few fixtures found: {}", files.len());
+    for (dir, name) in &files {
+        for fmt in ["-fa", "-ff", "-fd"] {
+            same_as_oracle(&o, dir, &format!("{fmt} {name}"));
+        }
+    }
+}
+
+/// Products (a chain is multiplied cheapest pair first, as the oracle does, which
+/// decides the single-precision rounding), sums, scaling, component transforms,
+/// transposes, XML input and RGBE output: byte-identical with the oracle.
+#[test]
+fn oracle_operations_are_byte_identical() {
+    let Some(o) = common::oracle() else { return };
+    let dir = common::scratch("rmtxop-ops");
+    for f in [
+        "T.mtx",
+        "D_rflux.dmx",
+        "test.m1.smx",
+        "blinds_kf.xml",
+        "sawtooth.xml",
+        "res_t1_mar21_1000_clear.dat",
+        "img_t1_mar21_1000_clear.hdr",
+    ] {
+        std::fs::copy(tp().join(f), dir.join(f)).unwrap();
+    }
+    for f in ["m23h.txt", "m32h.txt"] {
+        std::fs::copy(common::fixture(&format!("matrices/{f}")), dir.join(f)).unwrap();
+    }
+    for case in [
+        "-ff T.mtx D_rflux.dmx test.m1.smx",
+        "-ff -t test.m1.smx -t D_rflux.dmx T.mtx",
+        "-fa T.mtx . T.mtx . D_rflux.dmx . test.m1.smx",
+        "-fa -s 0.3 T.mtx + -s 0.7 T.mtx",
+        "-fd -s 0.3 0.2 0.1 T.mtx + -t -s 0.7 T.mtx",
+        "-fa -c .2 .3 .5 -s 1.7 T.mtx",
+        "-ff -c .2 .3 .5 .1 .1 .1 -s 3 2 T.mtx",
+        "-fa -c 47.435 119.93 11.635 -t res_t1_mar21_1000_clear.dat",
+        "-fa T.mtx * T.mtx",
+        "-fa sawtooth.xml",
+        "-fc T.mtx",
+        "-fa img_t1_mar21_1000_clear.hdr",
+        "-fa m23h.txt m32h.txt",
+        "-fa m23h.txt + m23h.txt",
+        "-fa -t m32h.txt + m23h.txt",
+        "-fa m23h.txt + m23h.txt m32h.txt",
+        "-fa -c 1 1 1 -t m23h.txt",
+        "-fa -s 2 m23h.txt",
+        "-fc -c 1 1 1 m23h.txt",
+        "m23h.txt",
+        "m23h.txt m23h.txt",
+    ] {
+        same_as_oracle(&o, &dir, case);
+    }
+    // Written to a file, binary headers are padded so data start aligned, as Radiance does.
+    for fmt in ["-ff", "-fd"] {
+        let write = |mut c: Command, out: &str| {
+            let f = std::fs::File::create(dir.join(out)).unwrap();
+            let st = c
+                .current_dir(&dir)
+                .args([fmt, "T.mtx"])
+                .stdout(f)
+                .status()
+                .unwrap();
+            assert!(st.success());
+            std::fs::read(dir.join(out)).unwrap()
+        };
+        let a = write(o.command("rmtxop"), "o.bin");
+        let b = write(common::fenestra("rmtxop"), "f.bin");
+        assert!(a == b, "{fmt} to a file differs from the oracle's");
+    }
+}
+
+/// From a coloured XML BSDF, Radiance stores each element's chromaticity quantised with a
+/// random dither (see tests/bsdf_xml.rs), so only the luminance is reproducible: the
+/// `-c .265 .670 .065` (Y) matrix agrees within 2e-5 relative (float storage and the
+/// 4-digit primaries' round-off), also through a product with D.
+#[test]
+fn oracle_xml_luminance_agrees() {
+    let Some(o) = common::oracle() else { return };
+    let dir = common::scratch("rmtxop-xml");
+    for f in ["blinds_kf.xml", "D_rflux.dmx"] {
+        std::fs::copy(tp().join(f), dir.join(f)).unwrap();
+    }
+    for case in [
+        "-fd -c .265 .670 .065 blinds_kf.xml",
+        "-fd -c .265 .670 .065 blinds_kf.xml -c .265 .670 .065 D_rflux.dmx",
+    ] {
+        let a = words(case);
+        let values = |out: Output| -> Vec<f64> {
+            assert!(out.status.success());
+            let p = out.stdout.windows(2).position(|w| w == b"\n\n").unwrap() + 2;
+            out.stdout[p..]
+                .chunks_exact(8)
+                .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+                .collect()
+        };
+        let theirs = values(run(o.command("rmtxop"), &dir, &a));
+        let ours = values(run(common::fenestra("rmtxop"), &dir, &a));
+        assert_eq!(theirs.len(), ours.len());
+        let mut worst = 0.0f64;
+        for (t, u) in theirs.iter().zip(&ours) {
+            if t.abs() > 1e-6 {
+                worst = worst.max((u / t - 1.0).abs());
+            } else {
+                assert!(u.abs() < 2e-6, "{case}: oracle {t}, ours {u}");
+            }
+        }
+        eprintln!("{case}: max relative difference {worst:.2e}");
+        assert!(worst < 2e-5, "{case}: luminance differs by {worst:e}");
+    }
+}
+
+/// Bad inputs: one clear message naming the problem, non-zero exit, nothing on stdout.
+#[test]
+fn bad_input_fails_cleanly() {
+    let dir = common::scratch("rmtxop-bad");
+    let t = std::fs::read(tp().join("T.mtx")).unwrap();
+    std::fs::write(dir.join("trunc.f"), &t[..1000]).unwrap();
+    let res = std::fs::read_to_string(tp().join("res_t1_mar21_1000_clear.dat")).unwrap();
+    std::fs::write(dir.join("more.dat"), res.replace("NROWS=45", "NROWS=50")).unwrap();
+    std::fs::write(dir.join("fewer.dat"), res.replace("NROWS=45", "NROWS=40")).unwrap();
+    std::fs::write(
+        dir.join("fmt.dat"),
+        res.replace("FORMAT=ascii", "FORMAT=fancy"),
+    )
+    .unwrap();
+    let tt = String::from_utf8_lossy(&t[..300]).to_string();
+    let hlen = tt.find("\n\n").unwrap() + 2;
+    let mut cols = tt[..hlen].replace("NCOLS=145", "NCOLS=146").into_bytes();
+    cols.extend_from_slice(&t[hlen..]);
+    std::fs::write(dir.join("cols.f"), cols).unwrap();
+    std::fs::copy(common::fixture("matrices/m23h.txt"), dir.join("m23h.txt")).unwrap();
+    for (args, want) in [
+        ("trunc.f", "truncated"),
+        ("more.dat", "unexpected end of data"),
+        ("fewer.dat", "more data than the header"),
+        ("fmt.dat", "unknown data format"),
+        ("cols.f", "truncated"),
+        ("missing.mtx", "missing.mtx"),
+        ("m23h.txt m23h.txt", "mismatched sizes"),
+        ("m23h.txt + -t m23h.txt", "mismatched"),
+        ("-c 1 2 m23h.txt", "coefficients"),
+        ("-s 1 2 m23h.txt", "one factor"),
+        ("m23h.txt +", "after the last matrix"),
+        ("-fx m23h.txt", "unknown output format"),
+        ("-fc -c 1 1 1 1 1 1 m23h.txt", "RGBE"),
+        ("-rf blinds.xml", "not supported"),
+        ("m23h.txt / m23h.txt", "not supported"),
+    ] {
+        let out = run(
+            common::fenestra("rmtxop"),
+            &dir,
+            &words(&format!("-fa {args}")),
+        );
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "rmtxop {args} succeeded");
+        assert!(out.stdout.is_empty(), "rmtxop {args} wrote output");
+        assert!(
+            err.contains(want),
+            "rmtxop {args}: message '{err}' lacks '{want}'"
+        );
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
