@@ -1,8 +1,495 @@
-//! rtcontrib (being written; see the open issues).
+//! rtcontrib / rcontrib: trace rays and accumulate what reaches tracked modifiers, per bin
+//! (Radiance's contribution tracer). The work is in the fenestra-contrib crate; this module
+//! parses the command line (left to right, as Radiance does) and drives the run.
 
 use std::process::ExitCode;
 
-/// Runs rtcontrib.
-pub fn run(_args: Vec<String>) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("not implemented yet")
+use anyhow::{bail, Context, Result};
+use fenestra_contrib::calc::{is_zero_constant, parse_params, BinRequest, Bins, CalcDefs};
+use fenestra_contrib::engine::{
+    read_rays, Engine, InFormat, InputRay, Record, RunOptions, Tracked,
+};
+use fenestra_contrib::output::{self, Format, HeaderInfo, ModOut, Spec, Stream};
+use fenestra_trace::{TraceOptions, Tracer};
+
+const USAGE: &str = "[-n N][-V][-I][-c N][-f{a,f,d}{a,f,d,c}][-fo][-x X -y Y][-o spec][-E][-Eo spec][-Eb N][-p a=1,..][-e expr][-f file.cal][-b binexpr][-bn N] {-m mod | -M file} .. [-ab N -ad N -lw W -lr N -ds V -dj V -st V -ss V -bv -seed N ..] scene.{oct,rad} ..";
+
+struct ModArg {
+    name: String,
+    spec: Option<Spec>,
+    err_spec: Option<Spec>,
+    params: Vec<(String, f64)>,
+    bin: String,
+    nbins: usize,
+}
+
+/// `-X`, `-X+`, `-X-`, `+X` (and `0`/`1`) forms of a toggle; `None` if `a` is not that toggle.
+fn toggle(a: &str, name: &str, cur: bool) -> Option<bool> {
+    if let Some(rest) = a.strip_prefix('+') {
+        return (rest == name).then_some(true);
+    }
+    let rest = a.strip_prefix('-')?.strip_prefix(name)?;
+    match rest {
+        "" => Some(!cur),
+        "+" | "1" => Some(true),
+        "-" | "0" => Some(false),
+        _ => None,
+    }
+}
+
+fn num(args: &[String], i: usize) -> Result<f64> {
+    let w = args
+        .get(i)
+        .with_context(|| format!("option {} needs a value", args[i - 1]))?;
+    fenestra_cli::opts::parse_real(w)
+        .with_context(|| format!("option {}: '{w}' is not a number", args[i - 1]))
+}
+
+fn word(args: &[String], i: usize) -> Result<&str> {
+    args.get(i)
+        .map(String::as_str)
+        .with_context(|| format!("option {} needs an argument", args[i - 1]))
+}
+
+/// Runs rtcontrib (also installed as rcontrib).
+pub fn run(args: Vec<String>) -> Result<ExitCode> {
+    if args.iter().skip(1).any(|a| a == "--help") {
+        println!(
+            "{} {USAGE}\nTraces rays read from standard input (origin direction; with -I point normal) and writes, for each record, the contribution coefficients of the tracked modifiers per bin.\nSee docs/tools/rtcontrib.md.",
+            fenestra_cli::prog()
+        );
+        return Ok(ExitCode::SUCCESS);
+    }
+    let mut o = TraceOptions::rcontrib();
+    let (mut irr, mut value, mut header, mut warnings, mut overwrite, mut errors) =
+        (false, false, true, true, false, false);
+    let mut count = 1usize;
+    let (mut xres, mut yres, mut nproc, mut batches) = (0usize, 0usize, 1usize, 8usize);
+    let (mut fin, mut fout) = (InFormat::Ascii, Format::Ascii);
+    let mut defs = CalcDefs::new();
+    let mut cur_spec: Option<Spec> = None;
+    let mut cur_err: Option<Spec> = None;
+    let mut cur_params: Vec<(String, f64)> = Vec::new();
+    let mut cur_bin = "0".to_string();
+    let mut cur_nbins: Option<usize> = None;
+    let mut mods: Vec<ModArg> = Vec::new();
+    let mut files: Vec<String> = Vec::new();
+    let mut first_file = args.len();
+    let mut i = 1;
+    let add_mod = |name: &str,
+                   mods: &mut Vec<ModArg>,
+                   spec: &Option<Spec>,
+                   err: &Option<Spec>,
+                   params: &[(String, f64)],
+                   bin: &str,
+                   nb: Option<usize>|
+     -> Result<()> {
+        if name == "void" {
+            bail!("cannot track 'void' modifier");
+        }
+        if mods.iter().any(|m| m.name == name) {
+            bail!("duplicate modifier '{name}'");
+        }
+        let konst = fenestra_cli::opts::parse_real(bin.trim());
+        if let Some(k) = konst {
+            if k != 0.0 {
+                bail!("illegal non-zero constant for bin ({bin})");
+            }
+        }
+        let nbins = match nb {
+            Some(n) if n > 0 => n,
+            None if is_zero_constant(bin) => 1,
+            _ => bail!("unspecified or illegal bin count for modifier '{name}'"),
+        };
+        mods.push(ModArg {
+            name: name.to_string(),
+            spec: spec.clone(),
+            err_spec: err.clone(),
+            params: params.to_vec(),
+            bin: bin.to_string(),
+            nbins,
+        });
+        Ok(())
+    };
+    while i < args.len() {
+        let a = args[i].as_str();
+        if !(a.starts_with('-') || a.starts_with('+')) || a == "-" {
+            first_file = i;
+            files.extend(args[i..].iter().cloned());
+            break;
+        }
+        if let Some(v) = toggle(a, "V", value) {
+            value = v;
+        } else if let Some(v) = toggle(a, "I", irr) {
+            irr = v;
+        } else if let Some(v) = toggle(a, "h", header) {
+            header = v;
+        } else if let Some(v) = toggle(a, "w", warnings) {
+            warnings = v;
+        } else if let Some(v) = toggle(a, "bv", o.bv) {
+            o.bv = v;
+        } else if let Some(v) = toggle(a, "fo", overwrite) {
+            overwrite = v;
+        } else if let Some(v) = toggle(a, "E", errors) {
+            errors = v;
+        } else if toggle(a, "u", true).is_some() || toggle(a, "dv", true).is_some() {
+            // -u: fenestra's random streams are always keyed by the seed and ray index.
+        } else if let Some(v) = toggle(a, "i", false) {
+            if v {
+                bail!("-i (irradiance at the first intersection) is not supported by fenestra's rtcontrib; use -I with the points and normals");
+            }
+        } else if let Some(v) = toggle(a, "ld", false) {
+            if v {
+                bail!("-ld+ (ray length limited by the direction's length) is not supported by fenestra's rtcontrib");
+            }
+        } else if let Some(v) = toggle(a, "r", false) {
+            if v {
+                bail!("-r (recover an interrupted run) is not supported by fenestra's rtcontrib: outputs are written whole at the end of a run (no partial files to recover); run again");
+            }
+        } else if a == "-f" {
+            defs.push_file(word(&args, i + 1)?)?;
+            i += 1;
+        } else if let Some(f) = a.strip_prefix("-f") {
+            let c: Vec<char> = f.chars().collect();
+            if c.len() > 2 {
+                bail!("Illegal i/o format '{a}'");
+            }
+            fin = match c[0] {
+                'a' => InFormat::Ascii,
+                'f' => InFormat::Float,
+                'd' => InFormat::Double,
+                _ => bail!("Illegal i/o format '{a}' (input: a, f, d)"),
+            };
+            fout = Format::from_letter(*c.get(1).unwrap_or(&c[0]), true)?;
+        } else {
+            let name = &a[1..];
+            match name {
+                "n" => {
+                    let n = num(&args, i + 1)?;
+                    if n < 1.0 {
+                        bail!("bad number of processes ({n})");
+                    }
+                    nproc = n as usize;
+                }
+                "c" => count = num(&args, i + 1)?.max(0.0) as usize,
+                "x" => xres = num(&args, i + 1)?.max(0.0) as usize,
+                "y" => yres = num(&args, i + 1)?.max(0.0) as usize,
+                "t" => {
+                    num(&args, i + 1)?;
+                }
+                "o" => cur_spec = Some(Spec::parse(word(&args, i + 1)?)?),
+                "Eo" => cur_err = Some(Spec::parse(word(&args, i + 1)?)?),
+                "Eb" => batches = (num(&args, i + 1)?.max(2.0)) as usize,
+                "p" => {
+                    cur_params = parse_params(word(&args, i + 1)?)?;
+                    defs.push_params(&cur_params);
+                }
+                "e" => defs.push_expr(word(&args, i + 1)?)?,
+                "b" => cur_bin = word(&args, i + 1)?.to_string(),
+                "bn" => {
+                    let w = word(&args, i + 1)?;
+                    let v = defs
+                        .eval_now(w)
+                        .with_context(|| format!("-bn {w} (definitions must come before -bn)"))?;
+                    cur_nbins = if v + 0.5 >= 1.0 {
+                        Some((v + 0.5) as usize)
+                    } else {
+                        Some(0)
+                    };
+                }
+                "m" => add_mod(
+                    word(&args, i + 1)?,
+                    &mut mods,
+                    &cur_spec,
+                    &cur_err,
+                    &cur_params,
+                    &cur_bin,
+                    cur_nbins,
+                )?,
+                "M" => {
+                    let f = word(&args, i + 1)?;
+                    let path = fenestra_cli::raypath::find_or_err(f)?;
+                    let text = std::fs::read_to_string(&path).with_context(|| {
+                        format!("cannot read modifier file '{}'", path.display())
+                    })?;
+                    for m in text.split_whitespace() {
+                        add_mod(
+                            m,
+                            &mut mods,
+                            &cur_spec,
+                            &cur_err,
+                            &cur_params,
+                            &cur_bin,
+                            cur_nbins,
+                        )?;
+                    }
+                }
+                "ab" => o.ab = num(&args, i + 1)?.max(0.0) as u32,
+                "ad" => o.ad = num(&args, i + 1)?.max(1.0) as u32,
+                "lw" => o.lw = num(&args, i + 1)?,
+                "lr" => o.lr = num(&args, i + 1)? as i32,
+                "ds" => o.ds = num(&args, i + 1)?,
+                "dj" => o.dj = num(&args, i + 1)?,
+                "dc" => o.dc = num(&args, i + 1)?,
+                "dr" => o.dr = num(&args, i + 1)? as i32,
+                "st" => o.st = num(&args, i + 1)?,
+                "ss" => o.ss = num(&args, i + 1)?,
+                "seed" => o.seed = num(&args, i + 1)? as u64,
+                "dt" | "dp" | "aa" | "ar" | "as" | "aw" | "mg" | "ms" => {
+                    // -dt, -as and -aa are forced to 0 by rcontrib; the others do not apply.
+                    num(&args, i + 1)?;
+                }
+                "af" | "ai" | "ae" | "aI" | "aE" => {
+                    word(&args, i + 1)?;
+                }
+                "av" | "me" | "ma" => {
+                    let v = [num(&args, i + 1)?, num(&args, i + 2)?, num(&args, i + 3)?];
+                    if name == "av" {
+                        o.av = v;
+                    } else if v.iter().any(|&x| x != 0.0) {
+                        bail!("participating media (-{name}) are not supported by fenestra's rtcontrib");
+                    }
+                    i += 2;
+                }
+                "cs" => {
+                    if num(&args, i + 1)? != 3.0 {
+                        bail!("-cs: only 3 colour samples (RGB) are supported by fenestra");
+                    }
+                }
+                "cw" => {
+                    num(&args, i + 1)?;
+                    num(&args, i + 2)?;
+                    i += 1;
+                }
+                _ => bail!(
+                    "unknown option '{a}'\nusage: {} {USAGE}",
+                    fenestra_cli::prog()
+                ),
+            }
+            i += 1;
+        }
+        i += 1;
+    }
+    if mods.is_empty() {
+        bail!("missing required modifier argument");
+    }
+    if files.is_empty() {
+        bail!(
+            "missing scene file\nusage: {} {USAGE}",
+            fenestra_cli::prog()
+        );
+    }
+    o.dt = 0.0;
+    if count == 0 {
+        xres = 0;
+        yres = 0;
+    }
+    // Standard errors with -c 1 come from independent batches of -ad/N samples each.
+    if errors && count == 1 {
+        o.ad = (o.ad / batches as u32).max(1);
+    }
+
+    let refs: Vec<&str> = files.iter().map(String::as_str).collect();
+    let scene = fenestra_scene::load(&refs)?;
+    let mut scene_lines = Vec::new();
+    if files.len() == 1 && files[0] != "-" {
+        if let Ok(bytes) = std::fs::read(&files[0]) {
+            if fenestra_scene::compiled::is_compiled(&bytes) {
+                scene_lines = fenestra_scene::compiled::read(&bytes)?.header;
+            }
+        }
+    }
+    let tracer = Tracer::new(&scene, &o)?;
+    if warnings {
+        for w in tracer.warnings() {
+            fenestra_cli::warn(w);
+        }
+        if tracer.source_count() == 0 {
+            fenestra_cli::warn("no light sources found");
+        }
+    }
+    let mut tracked = Vec::new();
+    for m in &mods {
+        let scene_mods: Vec<usize> = scene
+            .prims
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| p.name == m.name && !p.is_surface())
+            .map(|(k, _)| k)
+            .collect();
+        if scene_mods.is_empty() && warnings {
+            fenestra_cli::warn(format!(
+                "modifier '{}' is not in the scene (its values are zero)",
+                m.name
+            ));
+        }
+        tracked.push(Tracked {
+            scene_mods,
+            nbins: m.nbins,
+        });
+    }
+    let reqs: Vec<BinRequest> = mods
+        .iter()
+        .map(|m| BinRequest {
+            expr: &m.bin,
+            params: &m.params,
+        })
+        .collect();
+    let bins = Bins::compile(&defs, &reqs)?;
+
+    // Output streams.
+    let picture = xres > 0 && yres > 0;
+    let outs: Vec<ModOut> = mods
+        .iter()
+        .map(|m| ModOut {
+            name: &m.name,
+            spec: m.spec.as_ref(),
+            nbins: m.nbins,
+        })
+        .collect();
+    let plans = output::plan(&outs, picture);
+    let mut err_specs = Vec::new();
+    if errors {
+        for m in &mods {
+            let s = match (&m.err_spec, &m.spec) {
+                (Some(e), _) => e.clone(),
+                (None, Some(s)) if !s.text.starts_with('!') => {
+                    Spec::parse(&format!("{}.err", s.text))?
+                }
+                _ => bail!(
+                    "-E: the values of modifier '{}' go to {}; name the file of their standard errors with -Eo spec (before -m)",
+                    m.name,
+                    if m.spec.is_some() { "a command" } else { "the standard output" }
+                ),
+            };
+            err_specs.push(s);
+        }
+    }
+    let err_outs: Vec<ModOut> = mods
+        .iter()
+        .zip(&err_specs)
+        .map(|(m, s)| ModOut {
+            name: &m.name,
+            spec: Some(s),
+            nbins: m.nbins,
+        })
+        .collect();
+    let err_plans = if errors {
+        output::plan(&err_outs, picture)
+    } else {
+        Vec::new()
+    };
+    output::check_files(&plans, overwrite)?;
+    output::check_files(&err_plans, overwrite)?;
+    for p in &err_plans {
+        if plans.iter().any(|q| q.name == p.name) {
+            bail!(
+                "-E: the standard errors would go to '{}', which also receives values",
+                p.name.as_deref().unwrap_or("standard output")
+            );
+        }
+    }
+
+    // Input.
+    let expect = if yres > 0 {
+        Some(yres * xres.max(1) * count.max(1))
+    } else {
+        None
+    };
+    let stdin = std::io::stdin();
+    let mut rd = std::io::BufReader::with_capacity(1 << 16, stdin.lock());
+    let rays: Vec<InputRay> = read_rays(&mut rd, fin, expect)?;
+
+    let info = HeaderInfo {
+        scene_lines,
+        command: fenestra_cli::command_line(&args[..first_file]),
+        xres,
+        yres,
+        format: fout,
+        header,
+        extra: Vec::new(),
+    };
+    let mut err_info = info.clone();
+    err_info.extra = vec!["CONTENTS= Monte Carlo standard error (1 sigma) of each value".into()];
+    let mut streams: Vec<Stream> = plans
+        .into_iter()
+        .map(|p| Stream::open(p, &info))
+        .collect::<Result<_>>()?;
+    let mut err_streams: Vec<Stream> = err_plans
+        .into_iter()
+        .map(|p| Stream::open(p, &err_info))
+        .collect::<Result<_>>()?;
+
+    let opts = RunOptions {
+        irradiance: irr,
+        value,
+        count,
+        errors,
+        batches,
+        nproc,
+    };
+    let engine = Engine::new(&tracer, &bins, scene.prims.len(), &tracked, opts);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(nproc).build()?;
+    let progress = fenestra_cli::progress::Progress::new(rays.len() as u64, fenestra_cli::prog());
+    let write = |rec: &Record, streams: &mut [Stream], err_streams: &mut [Stream]| -> Result<()> {
+        for s in streams.iter_mut() {
+            s.write_record(fout, rec.scale, |m, b| {
+                let k = engine.slot(m, b) * 3;
+                [rec.sums[k], rec.sums[k + 1], rec.sums[k + 2]]
+            })?;
+        }
+        if let Some(e) = &rec.errors {
+            for s in err_streams.iter_mut() {
+                s.write_record(fout, 1.0, |m, b| {
+                    let k = engine.slot(m, b) * 3;
+                    [e[k], e[k + 1], e[k + 2]]
+                })?;
+            }
+        }
+        Ok(())
+    };
+    if count == 0 {
+        let dummies = rays
+            .iter()
+            .filter(|r| r.dir == fenestra_trace::DVec3::ZERO)
+            .count();
+        if dummies > 0 && warnings {
+            fenestra_cli::warn("dummy ray(s) ignored during accumulation");
+        }
+        let rec = engine.sum_all(&rays, &pool, &|n| progress.inc(n))?;
+        write(&rec, &mut streams, &mut err_streams)?;
+    } else {
+        let nrec = rays.len().div_ceil(count);
+        if rays.len() % count != 0 && warnings {
+            fenestra_cli::warn("partial accumulation in final record");
+        }
+        let block = (8192 / count).max(8 * nproc).max(1);
+        let mut r = 0;
+        while r < nrec {
+            let n = block.min(nrec - r);
+            let recs = engine.records(&rays, r, n, &pool)?;
+            for rec in &recs {
+                write(rec, &mut streams, &mut err_streams)?;
+            }
+            let lo = r * count;
+            let hi = ((r + n) * count).min(rays.len());
+            progress.inc((hi - lo) as u64);
+            r += n;
+        }
+    }
+    progress.finish();
+    if warnings {
+        for b in engine.take_bad_bins() {
+            fenestra_cli::warn(format!("bad bin number ({b} ignored)"));
+        }
+    }
+    for s in streams.into_iter().chain(err_streams) {
+        s.finish()?;
+    }
+    if let Some(e) = expect {
+        if rays.len() < e {
+            bail!("unexpected EOF on input");
+        }
+    }
+    Ok(ExitCode::SUCCESS)
 }

@@ -1,1 +1,7 @@
-//! fenestra-contrib: the contribution tracer behind rtcontrib/rcontrib and the Klems window sampler behind genklemsamp (being written).
+//! fenestra-contrib: the contribution tracer behind rtcontrib/rcontrib (bins through .cal
+//! expressions, `-c` accumulation, output streams and headers, Monte Carlo standard errors)
+//! and the Klems window sampler behind genklemsamp.
+
+pub mod calc;
+pub mod engine;
+pub mod output;

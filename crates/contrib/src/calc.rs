@@ -1,0 +1,221 @@
+//! The `.cal` context of the contribution tracer: definitions from `-e`, `-f` and `-p` in
+//! command-line order (rayinit.cal first), bin-count expressions evaluated at parse time,
+//! and the compiled bin expressions evaluated for every tracked ray.
+
+use std::path::PathBuf;
+
+use anyhow::{anyhow, bail, Context, Result};
+use fenestra_calc::{Compiled, ExprId, Program, State, VarId};
+
+/// Host variables set from the ray that reached a tracked surface, in this order.
+pub const RAY_VARS: [&str; 27] = [
+    "Dx", "Dy", "Dz", "Nx", "Ny", "Nz", "Px", "Py", "Pz", "T", "Ts", "Rdot", "S", "Tx", "Ty", "Tz",
+    "Ix", "Iy", "Iz", "Jx", "Jy", "Jz", "Kx", "Ky", "Kz", "Lu", "Lv",
+];
+
+/// One definition source, in command-line order.
+#[derive(Debug, Clone)]
+enum Def {
+    Expr(String),
+    File(PathBuf),
+    Param(String, f64),
+}
+
+/// Definitions collected while the command line is parsed.
+#[derive(Debug, Clone, Default)]
+pub struct CalcDefs {
+    rayinit: Option<PathBuf>,
+    defs: Vec<Def>,
+}
+
+/// Parses `-p` assignments (`a=1,b=2`; separators `,` `;` `:` or blanks).
+pub fn parse_params(text: &str) -> Result<Vec<(String, f64)>> {
+    let mut out = Vec::new();
+    for item in text
+        .split(|c: char| c == ',' || c == ';' || c == ':' || c.is_whitespace())
+        .filter(|s| !s.is_empty())
+    {
+        let (name, val) = item
+            .split_once('=')
+            .with_context(|| format!("-p '{text}': expected name=value, found '{item}'"))?;
+        let name = name.trim();
+        if name.is_empty()
+            || !name
+                .chars()
+                .next()
+                .is_some_and(|c| c.is_alphabetic() || c == '_')
+        {
+            bail!("-p '{text}': bad variable name '{name}'");
+        }
+        let v = fenestra_cli::opts::parse_real(val.trim())
+            .with_context(|| format!("-p '{text}': '{val}' is not a number"))?;
+        out.push((name.to_string(), v));
+    }
+    Ok(out)
+}
+
+impl CalcDefs {
+    /// Starts with `rayinit.cal` preloaded when it is found on RAYPATH or in fenestra's lib.
+    pub fn new() -> Self {
+        CalcDefs {
+            rayinit: fenestra_cli::raypath::find("rayinit.cal"),
+            defs: Vec::new(),
+        }
+    }
+
+    /// Adds `-e` definitions (checked for syntax now).
+    pub fn push_expr(&mut self, text: &str) -> Result<()> {
+        let mut p = Program::for_renderer();
+        p.load_str("-e", text).map_err(|e| anyhow!("{e}"))?;
+        self.defs.push(Def::Expr(text.to_string()));
+        Ok(())
+    }
+
+    /// Adds a `-f` file, found on RAYPATH (checked for syntax now).
+    pub fn push_file(&mut self, name: &str) -> Result<()> {
+        let path = fenestra_cli::raypath::find_or_err(name)?;
+        let mut p = Program::for_renderer();
+        p.load_file(&path).map_err(|e| anyhow!("{e}"))?;
+        self.defs.push(Def::File(path));
+        Ok(())
+    }
+
+    /// Applies `-p` assignments now (they are applied again before each bin evaluation).
+    pub fn push_params(&mut self, params: &[(String, f64)]) {
+        for (n, v) in params {
+            self.defs.push(Def::Param(n.clone(), *v));
+        }
+    }
+
+    /// The program with every definition so far.
+    pub fn program(&self) -> Result<Program> {
+        let mut p = Program::for_renderer();
+        if let Some(r) = &self.rayinit {
+            p.load_file(r).map_err(|e| anyhow!("{e}"))?;
+        }
+        for d in &self.defs {
+            match d {
+                Def::Expr(t) => p.load_str("-e", t).map_err(|e| anyhow!("{e}"))?,
+                Def::File(f) => p.load_file(f).map_err(|e| anyhow!("{e}"))?,
+                Def::Param(n, v) => p.set_number(n, *v),
+            }
+        }
+        Ok(p)
+    }
+
+    /// Evaluates an expression with the definitions seen so far (rcontrib's `-bn`).
+    pub fn eval_now(&self, expr: &str) -> Result<f64> {
+        let mut p = self.program()?;
+        let vars = p.bind_vars(&RAY_VARS);
+        let id = p.add_expr("-bn", expr).map_err(|e| anyhow!("{e}"))?;
+        let exe = p.compile().map_err(|e| anyhow!("{e}"))?;
+        let mut st = exe.state();
+        st.set_all(&vars, &ray_values_default());
+        exe.eval_expr(&mut st, id)
+            .map_err(|e| anyhow!("bin count '{expr}': {e}"))
+    }
+}
+
+fn ray_values_default() -> [f64; 27] {
+    let mut v = [0.0; 27];
+    v[12] = 1.0; // S
+    v[16] = 1.0; // Ix
+    v[20] = 1.0; // Jy
+    v[24] = 1.0; // Kz
+    v
+}
+
+/// Values of [`RAY_VARS`] for a ray.
+pub fn ray_values(c: &fenestra_trace::Contribution) -> [f64; 27] {
+    let mut v = ray_values_default();
+    v[0..3].copy_from_slice(&c.dir.to_array());
+    v[3..6].copy_from_slice(&c.normal.to_array());
+    v[6..9].copy_from_slice(&c.hit.to_array());
+    v[9] = c.total_dist;
+    v[10] = c.dist;
+    v[11] = (-c.dir.dot(c.normal)).clamp(-1.0, 1.0);
+    v
+}
+
+/// Compiled bin expressions: one program per distinct `-p` parameter set.
+pub struct Bins {
+    groups: Vec<(Compiled, Vec<VarId>)>,
+    /// Per modifier: `None` for the constant bin 0, else (group, expression).
+    exprs: Vec<Option<(usize, ExprId)>>,
+}
+
+/// What a modifier needs from the calc context.
+pub struct BinRequest<'a> {
+    /// The `-b` expression text.
+    pub expr: &'a str,
+    /// The `-p` assignments in effect for the modifier.
+    pub params: &'a [(String, f64)],
+}
+
+/// Whether a bin expression is the constant zero (no evaluation needed).
+pub fn is_zero_constant(expr: &str) -> bool {
+    fenestra_cli::opts::parse_real(expr.trim()) == Some(0.0)
+}
+
+impl Bins {
+    /// Compiles the bin expressions of all modifiers with the complete definitions.
+    pub fn compile(defs: &CalcDefs, reqs: &[BinRequest]) -> Result<Bins> {
+        let mut keys: Vec<String> = Vec::new();
+        let mut progs: Vec<(Program, Vec<VarId>)> = Vec::new();
+        let mut placed: Vec<Option<(usize, ExprId)>> = Vec::new();
+        for r in reqs {
+            if is_zero_constant(r.expr) {
+                placed.push(None);
+                continue;
+            }
+            let key = format!("{:?}", r.params);
+            let g = match keys.iter().position(|k| *k == key) {
+                Some(g) => g,
+                None => {
+                    let mut p = defs.program()?;
+                    for (n, v) in r.params {
+                        p.set_number(n, *v);
+                    }
+                    let vars = p.bind_vars(&RAY_VARS);
+                    keys.push(key);
+                    progs.push((p, vars));
+                    progs.len() - 1
+                }
+            };
+            let id = progs[g]
+                .0
+                .add_expr("-b", r.expr)
+                .map_err(|e| anyhow!("bin expression '{}': {e}", r.expr))?;
+            placed.push(Some((g, id)));
+        }
+        let mut groups = Vec::new();
+        for (p, vars) in progs {
+            groups.push((p.compile().map_err(|e| anyhow!("{e}"))?, vars));
+        }
+        Ok(Bins {
+            groups,
+            exprs: placed,
+        })
+    }
+
+    /// Fresh evaluation states, one per group (one set per thread).
+    pub fn states(&self) -> Vec<State> {
+        self.groups.iter().map(|(c, _)| c.state()).collect()
+    }
+
+    /// The bin value of modifier `m` for a ray (not yet rounded).
+    pub fn eval(&self, m: usize, vals: &[f64; 27], states: &mut [State]) -> Result<f64> {
+        let Some((g, id)) = self.exprs[m] else {
+            return Ok(0.0);
+        };
+        let (exe, vars) = &self.groups[g];
+        let st = &mut states[g];
+        st.set_all(vars, vals);
+        exe.eval_expr(st, id).map_err(|e| anyhow!("{e}"))
+    }
+
+    /// Whether modifier `m` has a non-constant bin expression.
+    pub fn varies(&self, m: usize) -> bool {
+        self.exprs[m].is_some()
+    }
+}

@@ -1,0 +1,423 @@
+//! Tracing input rays, binning what reaches tracked modifiers, accumulating records
+//! (`-c N` averages, `-c 0` sums) and the Monte Carlo standard error of every value.
+
+use std::collections::BTreeSet;
+use std::io::BufRead;
+use std::sync::Mutex;
+
+use anyhow::{anyhow, Result};
+use fenestra_calc::State;
+use fenestra_trace::{Contribution, DVec3, Tracer};
+use rayon::prelude::*;
+
+use crate::calc::{ray_values, Bins};
+
+/// Input data format (`-fi`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InFormat {
+    /// Text: six numbers per ray.
+    Ascii,
+    /// Six 32-bit floats.
+    Float,
+    /// Six 64-bit floats.
+    Double,
+}
+
+/// One input ray: origin and direction (with `-I`: point and surface normal).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InputRay {
+    /// Origin (point).
+    pub org: DVec3,
+    /// Direction (normal); zero marks a dummy ray.
+    pub dir: DVec3,
+}
+
+/// Reads rays until the input ends, a word is not a number, or `limit` rays were read.
+/// A partial final ray is dropped. Returns the rays and whether the input ended early
+/// inside a ray (for warnings).
+pub fn read_rays(
+    rd: &mut dyn BufRead,
+    fmt: InFormat,
+    limit: Option<usize>,
+) -> Result<Vec<InputRay>> {
+    let mut rays = Vec::new();
+    let full = |rays: &Vec<InputRay>| limit.is_some_and(|l| rays.len() >= l);
+    let mut vals: Vec<f64> = Vec::with_capacity(6);
+    let push = |vals: &mut Vec<f64>, rays: &mut Vec<InputRay>| {
+        if vals.len() == 6 {
+            rays.push(InputRay {
+                org: DVec3::new(vals[0], vals[1], vals[2]),
+                dir: DVec3::new(vals[3], vals[4], vals[5]),
+            });
+            vals.clear();
+        }
+    };
+    match fmt {
+        InFormat::Ascii => {
+            let mut line = String::new();
+            'outer: while !full(&rays) {
+                line.clear();
+                if rd.read_line(&mut line)? == 0 {
+                    break;
+                }
+                for wd in line.split_whitespace() {
+                    match fenestra_cli::opts::parse_real(wd) {
+                        Some(v) => vals.push(v),
+                        None => break 'outer,
+                    }
+                    push(&mut vals, &mut rays);
+                    if full(&rays) {
+                        break 'outer;
+                    }
+                }
+            }
+        }
+        InFormat::Float | InFormat::Double => {
+            let size = if fmt == InFormat::Float { 4 } else { 8 };
+            let mut rec = vec![0u8; 6 * size];
+            while !full(&rays) {
+                let mut got = 0;
+                while got < rec.len() {
+                    let n = rd.read(&mut rec[got..])?;
+                    if n == 0 {
+                        break;
+                    }
+                    got += n;
+                }
+                if got < rec.len() {
+                    break;
+                }
+                for c in rec.chunks_exact(size) {
+                    vals.push(if size == 4 {
+                        f32::from_ne_bytes([c[0], c[1], c[2], c[3]]) as f64
+                    } else {
+                        f64::from_ne_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]])
+                    });
+                }
+                push(&mut vals, &mut rays);
+            }
+        }
+    }
+    Ok(rays)
+}
+
+/// A tracked modifier as the engine sees it.
+#[derive(Debug, Clone)]
+pub struct Tracked {
+    /// Scene indices of the primitives carrying this modifier's name.
+    pub scene_mods: Vec<usize>,
+    /// Number of bins.
+    pub nbins: usize,
+}
+
+/// Settings of a run.
+#[derive(Debug, Clone)]
+pub struct RunOptions {
+    /// `-I`: the input direction is a surface normal (irradiance).
+    pub irradiance: bool,
+    /// `-V`: contributions (coefficient × radiance) instead of coefficients.
+    pub value: bool,
+    /// `-c`: rays per record (0: one summed record).
+    pub count: usize,
+    /// Compute standard errors.
+    pub errors: bool,
+    /// With `-c 1` and errors: independent batches per ray (the value is their mean).
+    pub batches: usize,
+    /// Threads.
+    pub nproc: usize,
+}
+
+/// One output record: values and (when asked) standard errors, `3 × total bins` each.
+#[derive(Debug, Clone)]
+pub struct Record {
+    /// Summed values, RGB per bin, modifiers in order (the value is `sums × scale`).
+    pub sums: Vec<f64>,
+    /// 1/N for an average of N rays, 1 for a sum.
+    pub scale: f64,
+    /// Standard errors of `values`.
+    pub errors: Option<Vec<f64>>,
+}
+
+/// The contribution tracer.
+pub struct Engine<'a> {
+    tracer: &'a Tracer,
+    bins: &'a Bins,
+    tracked: Vec<bool>,
+    our_mod: Vec<u32>,
+    offsets: Vec<usize>,
+    nbins: Vec<usize>,
+    total: usize,
+    opts: RunOptions,
+    bad: Mutex<BTreeSet<i64>>,
+    fail: Mutex<Option<String>>,
+}
+
+#[derive(Default)]
+struct Acc {
+    sum: Vec<f64>,
+    sumsq: Vec<f64>,
+    tmp: Vec<f64>,
+    n: usize,
+}
+
+impl<'a> Engine<'a> {
+    /// Sets up tracking for `mods` (in command-line order) in a scene of `nprims` primitives.
+    pub fn new(
+        tracer: &'a Tracer,
+        bins: &'a Bins,
+        nprims: usize,
+        mods: &[Tracked],
+        opts: RunOptions,
+    ) -> Engine<'a> {
+        let mut tracked = vec![false; nprims];
+        let mut our_mod = vec![u32::MAX; nprims];
+        let mut offsets = Vec::new();
+        let mut total = 0;
+        for (k, m) in mods.iter().enumerate() {
+            for &s in &m.scene_mods {
+                tracked[s] = true;
+                our_mod[s] = k as u32;
+            }
+            offsets.push(total);
+            total += m.nbins;
+        }
+        Engine {
+            tracer,
+            bins,
+            tracked,
+            our_mod,
+            offsets,
+            nbins: mods.iter().map(|m| m.nbins).collect(),
+            total,
+            opts,
+            bad: Mutex::new(BTreeSet::new()),
+            fail: Mutex::new(None),
+        }
+    }
+
+    /// Number of values (RGB triplets) in a record.
+    pub fn total_bins(&self) -> usize {
+        self.total
+    }
+
+    /// Index of modifier `m`, bin `b` in a record's values (times 3 for RGB).
+    pub fn slot(&self, m: usize, b: usize) -> usize {
+        self.offsets[m] + b
+    }
+
+    /// Bad bin numbers met so far (for the warning), taken.
+    pub fn take_bad_bins(&self) -> Vec<i64> {
+        let mut b = self.bad.lock().unwrap_or_else(|e| e.into_inner());
+        std::mem::take(&mut *b).into_iter().collect()
+    }
+
+    fn trace_one(&self, index: u64, ray: &InputRay, acc: &mut [f64], states: &mut [State]) {
+        if ray.dir == DVec3::ZERO {
+            return;
+        }
+        let mut sink = |c: Contribution| {
+            let m = self.our_mod[c.modifier];
+            if m == u32::MAX {
+                return;
+            }
+            let m = m as usize;
+            let v = if self.opts.value { c.value } else { c.coef };
+            if self.opts.value && v.iter().all(|&x| x <= 1e-6) {
+                return;
+            }
+            let b = if self.bins.varies(m) {
+                let vals = ray_values(&c);
+                match self.bins.eval(m, &vals, states) {
+                    Ok(bv) => {
+                        if bv <= -0.5 || bv.is_nan() {
+                            return;
+                        }
+                        let bn = (bv + 0.5) as i64;
+                        if bn as usize >= self.nbins[m] {
+                            self.bad
+                                .lock()
+                                .unwrap_or_else(|e| e.into_inner())
+                                .insert(bn);
+                            return;
+                        }
+                        bn as usize
+                    }
+                    Err(e) => {
+                        let mut f = self.fail.lock().unwrap_or_else(|e| e.into_inner());
+                        if f.is_none() {
+                            *f = Some(e.to_string());
+                        }
+                        return;
+                    }
+                }
+            } else {
+                0
+            };
+            let s = (self.offsets[m] + b) * 3;
+            acc[s] += v[0];
+            acc[s + 1] += v[1];
+            acc[s + 2] += v[2];
+        };
+        if self.opts.irradiance {
+            self.tracer
+                .contributions_irradiance(index, ray.org, ray.dir, &self.tracked, &mut sink);
+        } else {
+            self.tracer
+                .contributions(index, ray.org, ray.dir, &self.tracked, &mut sink);
+        }
+    }
+
+    fn accumulate(&self, rays: impl Iterator<Item = (u64, InputRay)>, states: &mut [State]) -> Acc {
+        let n3 = self.total * 3;
+        let mut a = Acc {
+            sum: vec![0.0; n3],
+            ..Default::default()
+        };
+        if self.opts.errors {
+            a.sumsq = vec![0.0; n3];
+            a.tmp = vec![0.0; n3];
+        }
+        for (idx, r) in rays {
+            a.n += 1;
+            if self.opts.errors {
+                a.tmp.iter_mut().for_each(|x| *x = 0.0);
+                let mut tmp = std::mem::take(&mut a.tmp);
+                self.trace_one(idx, &r, &mut tmp, states);
+                for ((s, q), t) in a.sum.iter_mut().zip(a.sumsq.iter_mut()).zip(&tmp) {
+                    *s += t;
+                    *q += t * t;
+                }
+                a.tmp = tmp;
+            } else {
+                self.trace_one(idx, &r, &mut a.sum, states);
+            }
+        }
+        a
+    }
+
+    fn finish(&self, a: Acc, sum_only: bool) -> Record {
+        let n = a.n.max(1) as f64;
+        let errors = if self.opts.errors {
+            Some(
+                a.sum
+                    .iter()
+                    .zip(&a.sumsq)
+                    .map(|(s, q)| {
+                        if a.n < 2 {
+                            return 0.0;
+                        }
+                        let var = ((q - s * s / n) / (n - 1.0)).max(0.0);
+                        if sum_only {
+                            (n * var).sqrt()
+                        } else {
+                            (var / n).sqrt()
+                        }
+                    })
+                    .collect(),
+            )
+        } else {
+            None
+        };
+        Record {
+            sums: a.sum,
+            scale: if sum_only { 1.0 } else { 1.0 / n },
+            errors,
+        }
+    }
+
+    fn check_fail(&self) -> Result<()> {
+        if let Some(e) = self.fail.lock().unwrap_or_else(|e| e.into_inner()).take() {
+            return Err(anyhow!("bin expression: {e}"));
+        }
+        Ok(())
+    }
+
+    /// Computes records `first..first+n` of `rays` (`-c N ≥ 1`), in parallel, in order.
+    pub fn records(
+        &self,
+        rays: &[InputRay],
+        first: usize,
+        n: usize,
+        pool: &rayon::ThreadPool,
+    ) -> Result<Vec<Record>> {
+        let c = self.opts.count.max(1);
+        let batches = if self.opts.errors && c == 1 {
+            self.opts.batches.max(2)
+        } else {
+            1
+        };
+        let out: Vec<Record> = pool.install(|| {
+            (first..first + n)
+                .into_par_iter()
+                .map_init(
+                    || self.bins.states(),
+                    |states, r| {
+                        let acc = if batches > 1 {
+                            let ray = rays[r];
+                            self.accumulate(
+                                (0..batches).map(|j| ((r * batches + j) as u64, ray)),
+                                states,
+                            )
+                        } else {
+                            let lo = r * c;
+                            let hi = (lo + c).min(rays.len());
+                            self.accumulate((lo..hi).map(|k| (k as u64, rays[k])), states)
+                        };
+                        self.finish(acc, false)
+                    },
+                )
+                .collect()
+        });
+        self.check_fail()?;
+        Ok(out)
+    }
+
+    /// Computes the single summed record of `-c 0` (dummy rays skipped): fixed chunks
+    /// summed in parallel, then added in order (the same result for any thread count).
+    pub fn sum_all(
+        &self,
+        rays: &[InputRay],
+        pool: &rayon::ThreadPool,
+        progress: &dyn Fn(u64),
+    ) -> Result<Record> {
+        const CHUNK: usize = 256;
+        let idx: Vec<usize> = (0..rays.len())
+            .filter(|&k| rays[k].dir != DVec3::ZERO)
+            .collect();
+        let n3 = self.total * 3;
+        let mut total = Acc {
+            sum: vec![0.0; n3],
+            sumsq: if self.opts.errors {
+                vec![0.0; n3]
+            } else {
+                Vec::new()
+            },
+            ..Default::default()
+        };
+        for block in idx.chunks(CHUNK * 64) {
+            let parts: Vec<Acc> = pool.install(|| {
+                block
+                    .par_chunks(CHUNK)
+                    .map_init(
+                        || self.bins.states(),
+                        |states, ch| {
+                            self.accumulate(ch.iter().map(|&k| (k as u64, rays[k])), states)
+                        },
+                    )
+                    .collect()
+            });
+            for p in parts {
+                total.n += p.n;
+                for (t, s) in total.sum.iter_mut().zip(&p.sum) {
+                    *t += s;
+                }
+                for (t, s) in total.sumsq.iter_mut().zip(&p.sumsq) {
+                    *t += s;
+                }
+            }
+            progress(block.len() as u64);
+        }
+        self.check_fail()?;
+        Ok(self.finish(total, true))
+    }
+}

@@ -1,0 +1,519 @@
+//! Output destinations of the contribution tracer: `-o` specs with `%s`/`%d` fields,
+//! the streams they make (which modifier bins go where), headers, and record writing.
+
+use std::io::Write;
+use std::process::{Child, ChildStdin, Command, Stdio};
+
+use anyhow::{bail, Context, Result};
+use fenestra_cli::output::AtomicFile;
+
+/// Output data format (`-fXo`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// Text, `%.6e` and a tab per value.
+    Ascii,
+    /// 32-bit floats, native byte order.
+    Float,
+    /// 64-bit floats, native byte order.
+    Double,
+    /// RGBE, 4 bytes per bin.
+    Rgbe,
+}
+
+impl Format {
+    /// The format letter's meaning (`a f d c`).
+    pub fn from_letter(c: char, output: bool) -> Result<Format> {
+        Ok(match c {
+            'a' => Format::Ascii,
+            'f' => Format::Float,
+            'd' => Format::Double,
+            'c' if output => Format::Rgbe,
+            _ => bail!("Illegal i/o format '{c}' (input: a, f, d; output: a, f, d, c)"),
+        })
+    }
+
+    fn header_name(self) -> &'static str {
+        match self {
+            Format::Ascii => "ascii",
+            Format::Float => "float",
+            Format::Double => "double",
+            Format::Rgbe => "32-bit_rle_rgbe",
+        }
+    }
+}
+
+/// A parsed `-o` spec: where its `%s` and bin field are.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Spec {
+    /// The spec text.
+    pub text: String,
+    /// Has a `%s` field.
+    pub has_mod: bool,
+    /// Has a bin field (`%d`, `%03d`, `%x` …).
+    pub has_bin: bool,
+}
+
+impl Spec {
+    /// Parses a spec; any conversion other than one `%s` and one integer field is an error.
+    pub fn parse(text: &str) -> Result<Spec> {
+        let (mut has_mod, mut has_bin) = (false, false);
+        let b: Vec<char> = text.chars().collect();
+        let mut i = 0;
+        while i < b.len() {
+            if b[i] == '%' {
+                i += 1;
+                if b.get(i) == Some(&'%') {
+                    i += 1;
+                    continue;
+                }
+                while i < b.len() && (b[i].is_ascii_digit() || b[i] == '-' || b[i] == '+') {
+                    i += 1;
+                }
+                match b.get(i) {
+                    Some('s') if !has_mod => has_mod = true,
+                    Some('d' | 'i' | 'o' | 'x' | 'X') if !has_bin => has_bin = true,
+                    _ => bail!("bad output format '{text}' (one %s and one %d field allowed)"),
+                }
+            }
+            i += 1;
+        }
+        Ok(Spec {
+            text: text.to_string(),
+            has_mod,
+            has_bin,
+        })
+    }
+
+    /// The destination name for a modifier and bin.
+    pub fn expand(&self, modifier: &str, bin: usize) -> String {
+        let b: Vec<char> = self.text.chars().collect();
+        let mut out = String::new();
+        let mut i = 0;
+        while i < b.len() {
+            if b[i] != '%' {
+                out.push(b[i]);
+                i += 1;
+                continue;
+            }
+            i += 1;
+            if b.get(i) == Some(&'%') {
+                out.push('%');
+                i += 1;
+                continue;
+            }
+            let start = i;
+            while i < b.len() && (b[i].is_ascii_digit() || b[i] == '-' || b[i] == '+') {
+                i += 1;
+            }
+            let flags: String = b[start..i].iter().collect();
+            let left = flags.contains('-');
+            let zero = flags.trim_start_matches(['-', '+']).starts_with('0');
+            let width: usize = flags
+                .trim_start_matches(['-', '+', '0'])
+                .parse()
+                .unwrap_or(0);
+            let body = match b.get(i) {
+                Some('s') => modifier.to_string(),
+                Some('o') => format!("{bin:o}"),
+                Some('x') => format!("{bin:x}"),
+                Some('X') => format!("{bin:X}"),
+                _ => bin.to_string(),
+            };
+            i += 1;
+            let pad = width.saturating_sub(body.chars().count());
+            if left {
+                out.push_str(&body);
+                out.push_str(&" ".repeat(pad));
+            } else if zero && !matches!(b.get(i - 1), Some('s')) {
+                out.push_str(&"0".repeat(pad));
+                out.push_str(&body);
+            } else {
+                out.push_str(&" ".repeat(pad));
+                out.push_str(&body);
+            }
+        }
+        out
+    }
+}
+
+/// One output stream: its destination and the (modifier, bin) values of each record.
+#[derive(Debug, Clone)]
+pub struct StreamPlan {
+    /// Destination (`None`: standard output; `!cmd`: a command).
+    pub name: Option<String>,
+    /// Values of a record in order: (modifier index, bin).
+    pub items: Vec<(usize, usize)>,
+    /// `MODIFIER=` header value.
+    pub modifier: Option<String>,
+    /// `BIN=` header value.
+    pub bin: Option<usize>,
+    spec_has_mod: bool,
+}
+
+/// A modifier as far as outputs are concerned.
+pub struct ModOut<'a> {
+    /// Its name.
+    pub name: &'a str,
+    /// Its output spec (`None` = standard output).
+    pub spec: Option<&'a Spec>,
+    /// Its bin count.
+    pub nbins: usize,
+}
+
+/// Works out the streams for the modifiers, in command-line order. `picture`: with
+/// `-x -y` pictures, later modifiers sharing a `%d`-only spec move to the next unused
+/// file number (as Radiance does).
+pub fn plan(mods: &[ModOut], picture: bool) -> Vec<StreamPlan> {
+    let mut streams: Vec<StreamPlan> = Vec::new();
+    let mut used: Vec<(String, usize)> = Vec::new();
+    let add = |streams: &mut Vec<StreamPlan>,
+               name: Option<String>,
+               item: (usize, usize),
+               modname: &str,
+               bin: Option<usize>,
+               has_mod: bool| {
+        match streams.iter_mut().find(|s| s.name == name) {
+            Some(s) => s.items.push(item),
+            None => streams.push(StreamPlan {
+                name,
+                items: vec![item],
+                modifier: if has_mod {
+                    Some(modname.to_string())
+                } else {
+                    None
+                },
+                bin,
+                spec_has_mod: has_mod,
+            }),
+        }
+    };
+    for (m, md) in mods.iter().enumerate() {
+        match md.spec {
+            None => {
+                for b in 0..md.nbins {
+                    add(&mut streams, None, (m, b), md.name, None, false);
+                }
+            }
+            Some(sp) => {
+                let shift = if sp.has_bin && !sp.has_mod && picture {
+                    match used.iter_mut().find(|(t, _)| *t == sp.text) {
+                        Some((_, n)) => {
+                            let s = *n;
+                            *n += md.nbins;
+                            s
+                        }
+                        None => {
+                            used.push((sp.text.clone(), md.nbins));
+                            0
+                        }
+                    }
+                } else {
+                    0
+                };
+                for b in 0..md.nbins {
+                    let fileno = b + shift;
+                    let name = sp.expand(md.name, fileno);
+                    let bin = if sp.has_bin { Some(fileno) } else { None };
+                    add(&mut streams, Some(name), (m, b), md.name, bin, sp.has_mod);
+                }
+            }
+        }
+    }
+    for s in &mut streams {
+        if s.items.len() == 1 && !s.spec_has_mod {
+            s.modifier = Some(mods[s.items[0].0].name.to_string());
+        }
+    }
+    streams
+}
+
+/// What every header carries.
+#[derive(Debug, Clone)]
+pub struct HeaderInfo {
+    /// Lines from the scene's own header (e.g. the oconv command).
+    pub scene_lines: Vec<String>,
+    /// The command line without the scene files.
+    pub command: String,
+    /// `-x` and `-y`.
+    pub xres: usize,
+    /// `-y`.
+    pub yres: usize,
+    /// Output format.
+    pub format: Format,
+    /// Write the information header (`-h`).
+    pub header: bool,
+    /// Extra lines (e.g. what an error-estimate file holds).
+    pub extra: Vec<String>,
+}
+
+/// The header (and resolution string) of a stream.
+pub fn header_text(plan: &StreamPlan, info: &HeaderInfo) -> Vec<u8> {
+    let mut h = String::new();
+    let one = plan.items.len() == 1;
+    if info.header {
+        h.push_str("#?RADIANCE\n");
+        for l in &info.scene_lines {
+            h.push_str(l);
+            h.push('\n');
+        }
+        h.push_str(&info.command);
+        h.push('\n');
+        h.push_str("SOFTWARE= fenestra\n");
+        for l in fenestra_formats::picture::capdate_lines() {
+            h.push_str(&l);
+            h.push('\n');
+        }
+        h.push_str("NCOMP=3\n");
+        if let Some(m) = &plan.modifier {
+            h.push_str(&format!("MODIFIER={m}\n"));
+        }
+        if let Some(b) = plan.bin {
+            h.push_str(&format!("BIN={b}\n"));
+        }
+        for l in &info.extra {
+            h.push_str(l);
+            h.push('\n');
+        }
+        if info.yres > 0 {
+            h.push_str(&format!("NROWS={}\n", info.yres * info.xres.max(1)));
+        }
+        if !(info.xres > 0 && one) {
+            h.push_str(&format!("NCOLS={}\n", plan.items.len()));
+        }
+        if matches!(info.format, Format::Float | Format::Double) {
+            let be = if cfg!(target_endian = "big") { 1 } else { 0 };
+            h.push_str(&format!("BigEndian={be}\n"));
+        }
+        h.push_str(&format!("FORMAT={}\n\n", info.format.header_name()));
+    }
+    if info.xres > 0 && info.yres > 0 && one {
+        h.push_str(&format!("-Y {:8} +X {:8}\n", info.yres, info.xres));
+    }
+    h.into_bytes()
+}
+
+enum Dest {
+    Stdout(std::io::BufWriter<std::io::Stdout>),
+    File(AtomicFile),
+    Cmd(Child, std::io::BufWriter<ChildStdin>, String),
+}
+
+/// An open stream.
+pub struct Stream {
+    /// Its plan.
+    pub plan: StreamPlan,
+    dest: Dest,
+    buf: Vec<u8>,
+}
+
+/// Checks that files can be created (no existing file unless `overwrite`).
+pub fn check_files(plans: &[StreamPlan], overwrite: bool) -> Result<()> {
+    for p in plans {
+        if let Some(n) = &p.name {
+            if n.starts_with('!') {
+                continue;
+            }
+            if !overwrite && std::path::Path::new(n).exists() {
+                bail!("cannot open '{n}' for writing: the file exists (use -fo to overwrite)");
+            }
+        }
+    }
+    Ok(())
+}
+
+impl Stream {
+    /// Opens the destination and writes the header.
+    pub fn open(plan: StreamPlan, info: &HeaderInfo) -> Result<Stream> {
+        let dest = match &plan.name {
+            None => Dest::Stdout(std::io::BufWriter::with_capacity(
+                1 << 16,
+                std::io::stdout(),
+            )),
+            Some(n) if n.starts_with('!') => {
+                let cmd = &n[1..];
+                let mut child = Command::new("sh")
+                    .arg("-c")
+                    .arg(cmd)
+                    .stdin(Stdio::piped())
+                    .spawn()
+                    .with_context(|| format!("cannot run output command '{cmd}'"))?;
+                let stdin = child.stdin.take().context("no pipe to output command")?;
+                Dest::Cmd(
+                    child,
+                    std::io::BufWriter::with_capacity(1 << 16, stdin),
+                    cmd.to_string(),
+                )
+            }
+            Some(n) => {
+                if let Some(dir) = std::path::Path::new(n).parent() {
+                    if !dir.as_os_str().is_empty() && !dir.exists() {
+                        std::fs::create_dir_all(dir)
+                            .with_context(|| format!("cannot create folder '{}'", dir.display()))?;
+                    }
+                }
+                Dest::File(AtomicFile::create(n)?)
+            }
+        };
+        let mut s = Stream {
+            buf: header_text(&plan, info),
+            plan,
+            dest,
+        };
+        s.flush_buf()?;
+        Ok(s)
+    }
+
+    fn w(&mut self) -> &mut dyn Write {
+        match &mut self.dest {
+            Dest::Stdout(w) => w,
+            Dest::File(f) => f,
+            Dest::Cmd(_, w, _) => w,
+        }
+    }
+
+    fn flush_buf(&mut self) -> Result<()> {
+        let buf = std::mem::take(&mut self.buf);
+        let name = self
+            .plan
+            .name
+            .clone()
+            .unwrap_or_else(|| "standard output".into());
+        self.w()
+            .write_all(&buf)
+            .with_context(|| format!("write error on '{name}'"))?;
+        self.buf = buf;
+        self.buf.clear();
+        Ok(())
+    }
+
+    /// Writes one record; `value(m, b)` gives the RGB sums of modifier `m`, bin `b`,
+    /// to be multiplied by `scale` (in single precision for float and RGBE output, in
+    /// double precision otherwise, as Radiance does).
+    pub fn write_record(
+        &mut self,
+        format: Format,
+        scale: f64,
+        value: impl Fn(usize, usize) -> [f64; 3],
+    ) -> Result<()> {
+        for k in 0..self.plan.items.len() {
+            let (m, b) = self.plan.items[k];
+            let s = value(m, b);
+            let v = match format {
+                Format::Float | Format::Rgbe => s.map(|x| ((x as f32) * (scale as f32)) as f64),
+                _ => s.map(|x| x * scale),
+            };
+            match format {
+                Format::Ascii => {
+                    for c in v {
+                        self.buf.extend_from_slice(fmt_e(c).as_bytes());
+                        self.buf.push(b'\t');
+                    }
+                }
+                Format::Float => {
+                    for c in v {
+                        self.buf.extend_from_slice(&(c as f32).to_ne_bytes());
+                    }
+                }
+                Format::Double => {
+                    for c in v {
+                        self.buf.extend_from_slice(&c.to_ne_bytes());
+                    }
+                }
+                Format::Rgbe => {
+                    let p = fenestra_formats::rgbe::encode_f64(v);
+                    self.buf.extend_from_slice(&p);
+                }
+            }
+        }
+        if format == Format::Ascii {
+            self.buf.push(b'\n');
+        }
+        if self.buf.len() >= 1 << 15 {
+            self.flush_buf()?;
+        }
+        Ok(())
+    }
+
+    /// Flushes and closes: a file is renamed into place, a command is waited for.
+    pub fn finish(mut self) -> Result<()> {
+        self.flush_buf()?;
+        match self.dest {
+            Dest::Stdout(mut w) => w.flush()?,
+            Dest::File(f) => f.commit()?,
+            Dest::Cmd(mut child, mut w, cmd) => {
+                w.flush()
+                    .with_context(|| format!("write error on output command '{cmd}'"))?;
+                drop(w);
+                let st = child.wait()?;
+                if !st.success() {
+                    bail!("output command '{cmd}' failed ({st})");
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// C's `%e`: 6 digits after the point, exponent with sign and at least two digits.
+pub fn fmt_e(v: f64) -> String {
+    if !v.is_finite() {
+        return if v.is_nan() {
+            "nan".into()
+        } else if v > 0.0 {
+            "inf".into()
+        } else {
+            "-inf".into()
+        };
+    }
+    let s = format!("{v:.6e}");
+    let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
+    let e: i32 = e.parse().unwrap_or(0);
+    format!("{m}e{}{:02}", if e < 0 { '-' } else { '+' }, e.abs())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spec_fields() {
+        let s = Spec::parse("out/%s_%03d.dat").unwrap();
+        assert!(s.has_mod && s.has_bin);
+        assert_eq!(s.expand("sky", 7), "out/sky_007.dat");
+        assert!(Spec::parse("a%f").is_err());
+        assert!(Spec::parse("a%d%d").is_err());
+        assert_eq!(Spec::parse("v%x").unwrap().expand("m", 255), "vff");
+    }
+
+    #[test]
+    fn c_style_exponent() {
+        assert_eq!(fmt_e(1.23456789), "1.234568e+00");
+        assert_eq!(fmt_e(-2.5e-7), "-2.500000e-07");
+        assert_eq!(fmt_e(0.0), "0.000000e+00");
+    }
+
+    #[test]
+    fn picture_bins_shift() {
+        let sp = Spec::parse("v%03d.hdr").unwrap();
+        let mods = [
+            ModOut {
+                name: "g",
+                spec: Some(&sp),
+                nbins: 1,
+            },
+            ModOut {
+                name: "s",
+                spec: Some(&sp),
+                nbins: 3,
+            },
+        ];
+        let p = plan(&mods, true);
+        assert_eq!(p.len(), 4);
+        assert_eq!(p[3].name.as_deref(), Some("v003.hdr"));
+        assert_eq!(p[3].modifier.as_deref(), Some("s"));
+        let p = plan(&mods, false);
+        assert_eq!(p.len(), 3);
+        assert_eq!(p[0].items, vec![(0, 0), (1, 0)]);
+        assert_eq!(p[0].modifier, None);
+    }
+}
