@@ -82,7 +82,53 @@ mod libm {
     }
 }
 
+impl Builtin {
+    /// The name the language calls it by.
+    pub fn name(self) -> &'static str {
+        match self {
+            Builtin::If => "if",
+            Builtin::Select => "select",
+            Builtin::Math1(m) => m.name(),
+            Builtin::Atan2 => "atan2",
+            Builtin::Max => "max",
+            Builtin::Min => "min",
+            Builtin::Rand => "rand",
+            Builtin::Jn => "jn",
+            Builtin::Yn => "yn",
+            Builtin::In => "in",
+            Builtin::Arg => "arg",
+        }
+    }
+}
+
+/// The NaN Radiance's rcalc prints as `-nan` for `acos`/`asin` outside [-1, 1].
+const NEG_NAN: f64 = f64::from_bits(0xfff8_0000_0000_0000);
+
 impl Math1 {
+    /// The name the language calls it by.
+    pub fn name(self) -> &'static str {
+        match self {
+            Math1::Sqrt => "sqrt",
+            Math1::Sin => "sin",
+            Math1::Cos => "cos",
+            Math1::Tan => "tan",
+            Math1::Asin => "asin",
+            Math1::Acos => "acos",
+            Math1::Atan => "atan",
+            Math1::Exp => "exp",
+            Math1::Log => "log",
+            Math1::Log10 => "log10",
+            Math1::Floor => "floor",
+            Math1::Ceil => "ceil",
+            Math1::J0 => "j0",
+            Math1::J1 => "j1",
+            Math1::Y0 => "y0",
+            Math1::Y1 => "y1",
+            Math1::Erf => "erf",
+            Math1::Erfc => "erfc",
+        }
+    }
+
     /// Applies the function.
     #[inline]
     pub fn apply(self, x: f64) -> f64 {
@@ -91,6 +137,8 @@ impl Math1 {
             Math1::Sin => x.sin(),
             Math1::Cos => x.cos(),
             Math1::Tan => x.tan(),
+            Math1::Asin if x.abs() > 1.0 => NEG_NAN,
+            Math1::Acos if x.abs() > 1.0 => NEG_NAN,
             Math1::Asin => x.asin(),
             Math1::Acos => x.acos(),
             Math1::Atan => x.atan(),

@@ -50,27 +50,47 @@ pub struct Compiled {
 }
 
 /// Warnings Radiance prints while evaluating (counted; the host reports them).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct Warnings {
     /// `x/0` evaluated (result 0).
     pub division_by_zero: u32,
     /// `select` index out of range (result 0).
     pub select_domain: u32,
+    /// Built-in calls that returned 0 because an error flag was raised while they were
+    /// evaluated (Radiance's `NAME(): range error` / `NAME(): domain error`), in order.
+    pub library: Vec<(&'static str, ErrFlag)>,
+}
+
+/// The error flag a built-in call checks (C's `errno` in Radiance): raised by a
+/// division by zero (range) or an out-of-range `select` (domain).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum ErrFlag {
+    /// No error.
+    #[default]
+    None,
+    /// Division by zero.
+    Range,
+    /// `select` index out of range.
+    Domain,
 }
 
 impl Warnings {
     /// Whether any warning happened.
     pub fn any(&self) -> bool {
-        self.division_by_zero > 0 || self.select_domain > 0
+        self.division_by_zero > 0 || self.select_domain > 0 || !self.library.is_empty()
     }
 
-    /// The warning messages Radiance prints, one per occurrence.
-    pub fn messages(&self) -> Vec<&'static str> {
-        let mut v = vec!["Division by zero"; self.division_by_zero as usize];
-        v.extend(std::iter::repeat_n(
-            "select(): domain error",
-            self.select_domain as usize,
-        ));
+    /// The warning messages Radiance prints (grouped by kind).
+    pub fn messages(&self) -> Vec<String> {
+        let mut v = vec!["Division by zero".to_string(); self.division_by_zero as usize];
+        for (name, f) in &self.library {
+            let what = if *f == ErrFlag::Domain {
+                "domain"
+            } else {
+                "range"
+            };
+            v.push(format!("{name}(): {what} error"));
+        }
         v
     }
 }
@@ -93,6 +113,8 @@ pub struct State {
     fail: Option<Failure>,
     /// Warnings since the last [`State::take_warnings`].
     warnings: Warnings,
+    /// The error flag built-in calls check (see [`ErrFlag`]).
+    errno: ErrFlag,
 }
 
 pub(crate) struct Frame<'a> {
@@ -194,6 +216,7 @@ impl Compiled {
             depth: 0,
             fail: None,
             warnings: Warnings::default(),
+            errno: ErrFlag::None,
         }
     }
 
@@ -402,7 +425,41 @@ impl Compiled {
         0.0
     }
 
+    /// A built-in call as Radiance makes it: the error flag is cleared, the function
+    /// runs (evaluating its arguments), and if the flag was raised meanwhile the call
+    /// reports `NAME(): range/domain error` and returns 0 (the flag stays raised).
+    #[inline]
+    fn lib_call(
+        &self,
+        st: &mut State,
+        name: &'static str,
+        f: impl FnOnce(&Self, &mut State) -> f64,
+    ) -> f64 {
+        st.errno = ErrFlag::None;
+        let v = f(self, st);
+        if st.errno != ErrFlag::None {
+            self.lib_error(st, name)
+        } else {
+            v
+        }
+    }
+
+    #[cold]
+    fn lib_error(&self, st: &mut State, name: &'static str) -> f64 {
+        if name == "select" && st.errno == ErrFlag::Domain {
+            st.warnings.select_domain += 1;
+        }
+        if st.warnings.library.len() < 64 {
+            st.warnings.library.push((name, st.errno));
+        }
+        0.0
+    }
+
     fn call_builtin(&self, b: Builtin, args: &[Node], st: &mut State, fr: &Frame) -> f64 {
+        self.lib_call(st, b.name(), |c, st| c.builtin_body(b, args, st, fr))
+    }
+
+    fn builtin_body(&self, b: Builtin, args: &[Node], st: &mut State, fr: &Frame) -> f64 {
         let need = match b {
             Builtin::If => 3,
             Builtin::Atan2 | Builtin::Jn | Builtin::Yn => 2,
@@ -432,7 +489,7 @@ impl Compiled {
                 let n = self.eval(&args[0], st, fr);
                 let count = args.len() - 1;
                 if n < -0.5 {
-                    st.warnings.select_domain += 1;
+                    st.errno = ErrFlag::Domain;
                     return 0.0;
                 }
                 let i = (n + 0.5) as i64;
@@ -440,7 +497,7 @@ impl Compiled {
                     return count as f64;
                 }
                 if i as usize > count {
-                    st.warnings.select_domain += 1;
+                    st.errno = ErrFlag::Domain;
                     return 0.0;
                 }
                 self.eval(&args[i as usize], st, fr)
@@ -505,7 +562,8 @@ impl Compiled {
                 .unwrap_or(0.0),
             Node::Param(i) => self.param(*i, st, fr),
             Node::Neg(a) => -self.eval(a, st, fr),
-            Node::Add(p) => self.eval(&p.0, st, fr) + self.eval(&p.1, st, fr),
+            // Radiance sums from 0, so a sum of negative zeros is +0.
+            Node::Add(p) => self.eval(&p.0, st, fr) + self.eval(&p.1, st, fr) + 0.0,
             Node::Sub(p) => self.eval(&p.0, st, fr) - self.eval(&p.1, st, fr),
             Node::Mul(p) => self.eval(&p.0, st, fr) * self.eval(&p.1, st, fr),
             Node::Div(p) => {
@@ -513,6 +571,7 @@ impl Compiled {
                 let b = self.eval(&p.1, st, fr);
                 if b == 0.0 {
                     st.warnings.division_by_zero += 1;
+                    st.errno = ErrFlag::Range;
                     0.0
                 } else {
                     a / b
@@ -522,18 +581,18 @@ impl Compiled {
                 let a = self.eval(&p.0, st, fr);
                 a.powf(self.eval(&p.1, st, fr))
             }
-            Node::If(t) => {
-                if self.eval(&t.0, st, fr) > 0.0 {
-                    self.eval(&t.1, st, fr)
+            Node::If(t) => self.lib_call(st, "if", |c, st| {
+                if c.eval(&t.0, st, fr) > 0.0 {
+                    c.eval(&t.1, st, fr)
                 } else {
-                    self.eval(&t.2, st, fr)
+                    c.eval(&t.2, st, fr)
                 }
-            }
-            Node::Math1(m, a) => m.apply(self.eval(a, st, fr)),
-            Node::Atan2(p) => {
-                let y = self.eval(&p.0, st, fr);
-                y.atan2(self.eval(&p.1, st, fr))
-            }
+            }),
+            Node::Math1(m, a) => self.lib_call(st, m.name(), |c, st| m.apply(c.eval(a, st, fr))),
+            Node::Atan2(p) => self.lib_call(st, "atan2", |c, st| {
+                let y = c.eval(&p.0, st, fr);
+                y.atan2(c.eval(&p.1, st, fr))
+            }),
             Node::Builtin(b, args) => self.call_builtin(*b, args, st, fr),
             Node::CallUser(f, args) => self.call_user(*f, args, st, fr),
             Node::CallHost(h, args) => self.call_host(*h, args, st, fr),

@@ -27,5 +27,5 @@ mod program;
 
 pub use builtins::Extras;
 pub use error::{CalcError, ErrorKind, Location};
-pub use eval::{Compiled, State, Warnings, MAX_DEPTH};
+pub use eval::{Compiled, ErrFlag, State, Warnings, MAX_DEPTH};
 pub use program::{ExprId, FuncId, HostFn, Program, VarId};

@@ -1,0 +1,350 @@
+//! rcalc from the command line, and differential tests against the oracle's rcalc:
+//! lib/rayinit.cal function by function, the bin functions of lib/*.cal on the
+//! reference directions, and a generated corpus of small programs.
+
+mod common;
+
+use std::io::Write;
+use std::path::Path;
+use std::process::{Command, Stdio};
+
+/// Runs a command with `input` on stdin; returns (success, stdout, stderr).
+fn run_with(mut cmd: Command, input: &[u8]) -> (bool, String, String) {
+    let mut child = cmd
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap_or_else(|e| panic!("cannot run {cmd:?}: {e}"));
+    let mut stdin = child.stdin.take().unwrap();
+    let data = input.to_vec();
+    let feeder = std::thread::spawn(move || {
+        // A program that fails early may close its input: ignore the broken pipe.
+        let _ = stdin.write_all(&data);
+    });
+    let out = child.wait_with_output().unwrap();
+    let _ = feeder.join();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// Our rcalc with our lib/ on RAYPATH.
+fn ours(args: &[&str]) -> Command {
+    let mut c = common::fenestra("rcalc");
+    c.env("RAYPATH", format!(".:{}", lib().display()));
+    c.args(args);
+    c
+}
+
+fn lib() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("lib")
+}
+
+/// All combinations of `n` values from `grid`, one record per line.
+fn grid_records(grid: &[f64], n: usize) -> String {
+    let mut idx = vec![0usize; n];
+    let mut s = String::new();
+    loop {
+        let rec: Vec<String> = idx.iter().map(|&i| format!("{}", grid[i])).collect();
+        s.push_str(&rec.join(" "));
+        s.push('\n');
+        let mut k = 0;
+        loop {
+            if k == n {
+                return s;
+            }
+            idx[k] += 1;
+            if idx[k] < grid.len() {
+                break;
+            }
+            idx[k] = 0;
+            k += 1;
+        }
+    }
+}
+
+/// Why exact: rcalc prints with a fixed number of significant digits and both
+/// sides evaluate the same arithmetic in double precision; the definitions in
+/// our lib/rayinit.cal follow the same operation order as Radiance's.
+#[test]
+fn oracle_rayinit_functions() {
+    let Some(o) = common::oracle() else { return };
+    let wide = [-2.5, -1.0, -0.3, 0.0, 0.25, 0.5, 1.0, 1.7, 3.0, 20.0];
+    let narrow = [-1.0, 0.0, 0.3, 1.0, 2.5];
+    let unit = [0.001, 0.1, 0.3, 0.5, 0.5001, 0.7, 0.95, 0.999];
+    // (expression over $1..$n, arity, grid)
+    let cases: &[(&str, usize, &[f64])] = &[
+        ("bound($1,$2,$3)", 3, &wide),
+        ("Acos($1)", 1, &wide),
+        ("Asin($1)", 1, &wide),
+        ("Atan2($1,$2)", 2, &wide),
+        ("Exp($1*50)", 1, &wide),
+        ("Sqrt($1)", 1, &wide),
+        ("and($1,$2)", 2, &wide),
+        ("or($1,$2)", 2, &wide),
+        ("not($1)", 1, &wide),
+        ("xor($1,$2)", 2, &wide),
+        ("abs($1)", 1, &wide),
+        ("sgn($1)", 1, &wide),
+        ("sq($1)", 1, &wide),
+        ("inside($1,$2,$3)", 3, &wide),
+        ("frac($1)", 1, &wide),
+        ("mod($1,$2)", 2, &wide),
+        ("tri($1,$2)", 2, &wide),
+        ("linterp($1,$2,$3)", 3, &wide),
+        ("noop($1)", 1, &wide),
+        ("clip($1)", 1, &wide),
+        ("noneg($1)", 1, &wide),
+        ("red($1,$2,$3)", 3, &narrow),
+        ("green($1,$2,$3)", 3, &narrow),
+        ("blue($1,$2,$3)", 3, &narrow),
+        ("grey($1,$2,$3)", 3, &wide),
+        ("clip_r($1,$2,$3)", 3, &narrow),
+        ("clip_g($1,$2,$3)", 3, &narrow),
+        ("clip_b($1,$2,$3)", 3, &narrow),
+        ("clipgrey($1,$2,$3)", 3, &wide),
+        ("fade($1,$2,$3*8)", 3, &wide),
+        ("hermite($1,$2,$3,$4,$5)", 5, &narrow),
+        ("bezier($1,$2,$3,$4,$5)", 5, &narrow),
+        ("bspline($1,$2,$3,$4,$5)", 5, &narrow),
+        ("unif2norm($1)", 1, &unit),
+        ("nrand($1)", 1, &wide),
+        ("dot(va,vb)", 3, &narrow),
+        ("cross(1,va,vb)", 3, &narrow),
+        ("cross(2,va,vb)", 3, &narrow),
+        ("cross(3,va,vb)", 3, &narrow),
+        ("PI+$1", 1, &narrow),
+        ("DEGREE*$1", 1, &narrow),
+        ("FTINY*$1", 1, &narrow),
+    ];
+    let vecs = "va(i)=select(i,$1,$2,$3);vb(i)=select(i,$3,-$1,$2*2);";
+    for (expr, n, grid) in cases {
+        let input = grid_records(grid, *n);
+        let prog = format!("{vecs}$1={expr}");
+        let args = ["-f", "rayinit.cal", "-e", &prog];
+        let mut oc = o.command("rcalc");
+        oc.args(args);
+        let (ook, oout, oerr) = run_with(oc, input.as_bytes());
+        let (fok, fout, ferr) = run_with(ours(&args), input.as_bytes());
+        assert_eq!(
+            ook, fok,
+            "{expr}: exit status differs\noracle: {oerr}\nours: {ferr}"
+        );
+        assert_eq!(
+            oout.lines().count(),
+            input.lines().count(),
+            "{expr}: oracle stopped early: {oerr}"
+        );
+        for ((i, a), b) in input.lines().zip(oout.lines()).zip(fout.lines()) {
+            assert_eq!(a, b, "{expr} on record '{i}'");
+        }
+        assert_eq!(oout, fout, "{expr}");
+    }
+}
+
+/// Names that need a renderer (host variables, arg(), noise) fail under both rcalcs.
+#[test]
+fn oracle_rayinit_renderer_names_fail_in_rcalc() {
+    let Some(o) = common::oracle() else { return };
+    for expr in [
+        "U",
+        "V",
+        "A1",
+        "AC",
+        "D(1)",
+        "Idx",
+        "noise3a(1,2,3)",
+        "turbulence(1,2,3,.3)",
+    ] {
+        let prog = format!("$1={expr}");
+        let args = ["-n", "-f", "rayinit.cal", "-e", &prog];
+        let mut oc = o.command("rcalc");
+        oc.args(args);
+        let (ook, _, _) = run_with(oc, b"");
+        let (fok, _, ferr) = run_with(ours(&args), b"");
+        assert!(!ook, "oracle accepted {expr}");
+        assert!(!fok, "we accepted {expr}");
+        assert!(ferr.contains("rayinit.cal"), "{expr}: {ferr}");
+    }
+}
+
+/// Reads a bins table: a header line, then tab-separated columns.
+fn table(path: &Path) -> Vec<Vec<String>> {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    text.lines()
+        .skip(1)
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| l.split('\t').map(str::to_string).collect())
+        .collect()
+}
+
+/// Directions (columns `dx..dx+3`) as rcalc input, with six slightly turned copies of
+/// each (for rows exactly on a boundary, where the neighbouring bin is also accepted).
+fn dirs_input(rows: &[Vec<String>], dx: usize) -> String {
+    let mut s = String::new();
+    for r in rows {
+        let d: Vec<f64> = (0..3).map(|k| r[dx + k].parse().unwrap()).collect();
+        s.push_str(&format!("{} {} {}\n", r[dx], r[dx + 1], r[dx + 2]));
+        for k in 0..6 {
+            let mut e = d.clone();
+            e[k / 2] += if k % 2 == 0 { 1e-9 } else { -1e-9 };
+            let n = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
+            s.push_str(&format!(
+                "{:.17e} {:.17e} {:.17e}\n",
+                e[0] / n,
+                e[1] / n,
+                e[2] / n
+            ));
+        }
+    }
+    s
+}
+
+/// Compares one output column of ours (7 lines per row: the direction then its nudged
+/// copies) with the oracle's column; boundary kinds (3, 6) accept a nudged answer.
+fn compare_bins(
+    what: &str,
+    rows: &[Vec<String>],
+    kind_col: usize,
+    want_col: usize,
+    ours: &[Vec<String>],
+    col: usize,
+) -> usize {
+    let mut boundary_neighbours = 0;
+    for (i, r) in rows.iter().enumerate() {
+        let want = &r[want_col];
+        let got = &ours[7 * i][col];
+        if got == want {
+            continue;
+        }
+        let kind = r[kind_col].as_str();
+        let near = (1..7).any(|k| &ours[7 * i + k][col] == want);
+        assert!(
+            (kind == "3" || kind == "6") && near,
+            "{what}: row {i} ({} {} {}, kind {kind}): ours {got}, oracle {want}",
+            r[kind_col - 3],
+            r[kind_col - 2],
+            r[kind_col - 1]
+        );
+        boundary_neighbours += 1;
+    }
+    boundary_neighbours
+}
+
+fn run_ours(args: &[&str], input: &str) -> Vec<Vec<String>> {
+    let (ok, out, err) = run_with(ours(args), input.as_bytes());
+    assert!(ok, "rcalc {args:?}: {err}");
+    out.lines()
+        .map(|l| l.split('\t').map(str::to_string).collect())
+        .collect()
+}
+
+/// lib/klems_*.cal against the oracle's bins (the `_lib` columns, computed by the
+/// oracle's rcalc with the .cal files shipped with it). Exact, except on rows lying
+/// exactly on a boundary (kinds 3 and 6) where the neighbouring bin is accepted.
+#[test]
+fn klems_bins_match_oracle_tables() {
+    for (file, f, cal) in [
+        ("klems_full_bins.tsv", "kbin", "klems_full.cal"),
+        ("klems_half_bins.tsv", "khbin", "klems_half.cal"),
+        ("klems_quarter_bins.tsv", "kqbin", "klems_quarter.cal"),
+    ] {
+        let rows = table(&common::fixture(&format!("klems/{file}")));
+        let input = dirs_input(&rows, 1);
+        let prog = format!(
+            "Dx=$1;Dy=$2;Dz=$3;$1={f}(0,0,1,0,1,0);$2={f}(0,0,-1,0,1,0);$3={f}(0,1,0,0,0,1);$4={f}(-1,0,0,0,0,1);$5={f}(0.6,0,0.8,0.1,1,0.3)"
+        );
+        let rh = run_ours(&["-f", cal, "-e", &prog], &input);
+        let lh = run_ours(
+            &[
+                "-f",
+                cal,
+                "-e",
+                "RHS=-1",
+                "-e",
+                &format!("Dx=$1;Dy=$2;Dz=$3;$1={f}(0,0,1,0,1,0)"),
+            ],
+            &input,
+        );
+        assert_eq!(rh.len(), 7 * rows.len());
+        let mut near = 0;
+        for (k, name) in ["front", "back", "south", "east", "tilt"]
+            .iter()
+            .enumerate()
+        {
+            near += compare_bins(&format!("{cal} {name}"), &rows, 4, 5 + k, &rh, k);
+        }
+        near += compare_bins(&format!("{cal} frontLH"), &rows, 4, 10, &lh, 0);
+        eprintln!(
+            "{cal}: {} rows x 6 frames, {near} boundary rows took the neighbouring bin",
+            rows.len()
+        );
+    }
+}
+
+/// lib/reinhart.cal against the oracle's `rbin`/`Nrbins` for MF 1, 2, 4 (same tolerance rule).
+#[test]
+fn reinhart_bins_match_oracle_tables() {
+    for mf in [1, 2, 4] {
+        let rows = table(&common::fixture(&format!("rcalc/reinhart{mf}_rbin.tsv")));
+        let input = dirs_input(&rows, 0);
+        let out = run_ours(
+            &[
+                "-e",
+                &format!("MF:{mf}"),
+                "-f",
+                "reinhart.cal",
+                "-e",
+                "Dx=$1;Dy=$2;Dz=$3;$1=rbin;$2=Nrbins",
+            ],
+            &input,
+        );
+        let near = compare_bins(&format!("reinhart MF {mf}"), &rows, 3, 4, &out, 0);
+        compare_bins(&format!("Nrbins MF {mf}"), &rows, 3, 5, &out, 1);
+        eprintln!(
+            "reinhart MF {mf}: {} rows, {near} boundary rows took the neighbouring bin",
+            rows.len()
+        );
+    }
+}
+
+/// lib/tregenza.cal against the oracle's tregenza.cal, run live on the same directions.
+#[test]
+fn oracle_tregenza_bins() {
+    let Some(o) = common::oracle() else { return };
+    let rows = table(&common::fixture("rcalc/reinhart1_rbin.tsv"));
+    let input: String = rows
+        .iter()
+        .map(|r| format!("{} {} {}\n", r[0], r[1], r[2]))
+        .collect();
+    let args = [
+        "-f",
+        "tregenza.cal",
+        "-e",
+        "Dx=$1;Dy=$2;Dz=$3;$1=tbin;$2=Ntbins",
+    ];
+    let mut oc = o.command("rcalc");
+    oc.args(args);
+    let (ook, oout, oerr) = run_with(oc, input.as_bytes());
+    assert!(ook, "{oerr}");
+    let (fok, fout, ferr) = run_with(ours(&args), input.as_bytes());
+    assert!(fok, "{ferr}");
+    let mut differ = 0;
+    for ((r, a), b) in rows.iter().zip(oout.lines()).zip(fout.lines()) {
+        if a != b {
+            assert!(
+                r[3] == "3" || r[3] == "6",
+                "tbin on {r:?}: oracle {a}, ours {b}"
+            );
+            differ += 1;
+        }
+    }
+    assert_eq!(oout.lines().count(), fout.lines().count());
+    eprintln!(
+        "tregenza: {} rows, {differ} boundary rows differ",
+        rows.len()
+    );
+}
