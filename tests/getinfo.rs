@@ -1,0 +1,107 @@
+//! getinfo from the command line and against the oracle's getinfo.
+
+mod common;
+
+use std::io::Write;
+use std::path::Path;
+use std::process::{Command, Output, Stdio};
+
+fn run(mut c: Command, dir: &Path, args: &[&str], stdin: Option<&[u8]>) -> Output {
+    c.current_dir(dir).args(args);
+    c.stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    let mut child = c
+        .spawn()
+        .unwrap_or_else(|e| panic!("cannot run {c:?}: {e}"));
+    let mut input = child.stdin.take().unwrap();
+    let data = stdin.map(<[u8]>::to_vec).unwrap_or_default();
+    let writer = std::thread::spawn(move || {
+        let _ = input.write_all(&data);
+    });
+    let out = child.wait_with_output().unwrap();
+    writer.join().unwrap();
+    out
+}
+
+fn files() -> Vec<(&'static str, String)> {
+    vec![
+        ("threephase", "T.mtx".into()),
+        ("threephase", "res_t1_mar21_1000_clear.dat".into()),
+        ("threephase", "img_t1_mar21_1000_clear.hdr".into()),
+        ("threephase", "V.vmx".into()),
+        ("sky", "test.m1.smx".into()),
+        ("matrices", "m23h.txt".into()),
+    ]
+}
+
+/// Header listings of files, header stripping (`-`), added lines (`-a`; the FORMAT line
+/// goes last, unpadded), picture dimensions (`-d`) and `-d -`: byte-identical with the
+/// oracle's output.
+#[test]
+fn oracle_getinfo_outputs_are_identical() {
+    let Some(o) = common::oracle() else { return };
+    let base = common::fixture("");
+    let names: Vec<String> = files().iter().map(|(d, f)| format!("{d}/{f}")).collect();
+    let all: Vec<&str> = names.iter().map(String::as_str).collect();
+    let cmp = |args: &[&str], stdin: Option<&[u8]>| {
+        let a = run(o.command("getinfo"), &base, args, stdin);
+        let b = run(common::fenestra("getinfo"), &base, args, stdin);
+        assert!(b.status.success(), "getinfo {args:?} failed");
+        assert!(a.stdout == b.stdout, "getinfo {args:?}: output differs");
+    };
+    cmp(&all, None);
+    for n in &names {
+        let data = std::fs::read(base.join(n)).unwrap();
+        cmp(&[], Some(&data));
+        cmp(&["-"], Some(&data));
+        cmp(&["-a", "added line", "x=1"], Some(&data));
+    }
+    let pic = "threephase/img_t1_mar21_1000_clear.hdr";
+    cmp(&["-d", pic], None);
+    let data = std::fs::read(base.join(pic)).unwrap();
+    cmp(&["-d"], Some(&data));
+    cmp(&["-d", "-"], Some(&data));
+}
+
+/// The reference workflow `rmtxop … | getinfo - | total` needs the data bytes unchanged.
+#[test]
+fn strip_keeps_binary_data_exactly() {
+    let base = common::fixture("threephase");
+    let data = std::fs::read(base.join("T.mtx")).unwrap();
+    let out = run(common::fenestra("getinfo"), &base, &["-"], Some(&data));
+    assert!(out.status.success());
+    let hlen = data.windows(2).position(|w| w == b"\n\n").unwrap() + 2;
+    assert!(out.stdout == data[hlen..]);
+}
+
+/// Matrix shapes with `-d` (a fenestra addition: Radiance 6.0a says "unknown file type").
+#[test]
+fn dimensions_of_a_matrix() {
+    let base = common::fixture("threephase");
+    let out = run(common::fenestra("getinfo"), &base, &["-d", "T.mtx"], None);
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout),
+        "T.mtx: NROWS=145 NCOLS=145 NCOMP=3\n"
+    );
+}
+
+/// Missing files and data without a header: a message naming the file, exit status 1.
+#[test]
+fn bad_input_is_reported() {
+    let dir = common::scratch("getinfo-bad");
+    std::fs::write(dir.join("noheader.txt"), "1 2 3\n4 5 6\n").unwrap();
+    for args in [
+        &["missing.hdr"][..],
+        &["noheader.txt"],
+        &["-d", "noheader.txt"],
+    ] {
+        let out = run(common::fenestra("getinfo"), &dir, args, None);
+        assert!(!out.status.success(), "getinfo {args:?} succeeded");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(args[args.len() - 1]), "{err}");
+    }
+    let out = run(common::fenestra("getinfo"), &dir, &["-"], Some(b"1 2 3\n"));
+    assert!(!out.status.success());
+    assert!(out.stdout.is_empty());
+}
