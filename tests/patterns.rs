@@ -122,3 +122,67 @@ fn pattern_errors_are_clear() {
         );
     }
 }
+
+#[test]
+fn oracle_data_patterns_match_rtrace() {
+    let Some(oracle) = common::oracle() else {
+        return;
+    };
+    let dir = common::scratch("datapatterns");
+    for c in ["R", "G", "B"] {
+        let f = format!("ill_glass{c}.dat");
+        std::fs::copy(common::fixture("datapattern").join(&f), dir.join(&f)).unwrap();
+    }
+    // A 1-D file for brightdata, with coordinates beyond its ends (linear extension).
+    std::fs::write(dir.join("ramp.dat"), "1\n-.5 .5 5\n1 2 4 3 2.5\n").unwrap();
+    let scene = "
+void colordata illum_mat.dist
+9 red green blue ill_glassR.dat ill_glassG.dat ill_glassB.dat illum.cal il_alth il_azih
+0
+9 -1 0 0  0 0 1  0 1 0
+illum_mat.dist glow panel 0 0 4 1 1 1 0
+panel polygon win 0 0 12  3 0 .9  3 0 2.4  1 0 2.4  1 0 .9
+
+void brightdata ramp 4 noneg ramp.dat . 2*Dx
+0
+0
+ramp glow wall 0 0 4 .5 .5 .5 0
+wall polygon back 0 0 12  -2 5 3  2 5 3  2 5 0  -2 5 0
+";
+    std::fs::write(dir.join("scene.rad"), scene).unwrap();
+    let mut rays = String::new();
+    for k in 0..40 {
+        let a = k as f64 * 0.157;
+        // from inside the room (y < 0) toward the window panel at y = 0
+        rays.push_str(&format!(
+            "2 -1.5 1.6 {} 1 {}\n",
+            a.cos() * 0.6,
+            a.sin() * 0.4
+        ));
+        // toward the far wall at y = 5, Dx spanning beyond [-.5, .5]
+        rays.push_str(&format!("0 0 1.5 {} 1 0\n", (k as f64 - 20.0) / 50.0));
+    }
+    let opts = ["-h", "-ab", "0", "-u-"];
+    let mut c = oracle.command("oconv");
+    c.arg("scene.rad").current_dir(&dir);
+    std::fs::write(dir.join("scene.oct"), common::run_ok(&mut c)).unwrap();
+    let mut theirs = oracle.command("rtrace");
+    theirs.args(opts).arg("scene.oct").current_dir(&dir);
+    let t = run(theirs, &rays);
+    assert!(t.status.success(), "{}", String::from_utf8_lossy(&t.stderr));
+    let mut ours = common::fenestra("rtrace");
+    ours.args(opts).arg("scene.rad").current_dir(&dir);
+    let o = run(ours, &rays);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (t, o) = (values(&t.stdout), values(&o.stdout));
+    assert_eq!(t.len(), o.len());
+    assert!(t.iter().filter(|v| **v > 0.0).count() > 100);
+    for (k, (a, b)) in t.iter().zip(&o).enumerate() {
+        // 6 printed digits; single-precision colours in Radiance.
+        assert!(
+            (a - b).abs() <= 2e-5 * a.abs().max(1e-3),
+            "value {k} (ray {}): oracle {a} ours {b}",
+            k / 3
+        );
+    }
+}

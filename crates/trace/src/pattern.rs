@@ -9,7 +9,9 @@
 use std::sync::Arc;
 
 use anyhow::{anyhow, bail, Result};
-use fenestra_calc::{Compiled, ExprId, Program, VarId};
+use fenestra_calc::{Compiled, ExprId, FuncId, Program, VarId};
+
+use crate::datafile::DataGrid;
 use fenestra_scene::Scene;
 use fenestra_sky::cie::SkyBright;
 use fenestra_sky::skyvec::PerezLum;
@@ -126,6 +128,54 @@ pub enum Pattern {
     Perez(PerezLum),
     /// Any other `brightfunc`/`colorfunc`, through the .cal engine.
     Cal(Arc<CalPattern>),
+    /// `brightdata`/`colordata`: interpolated data files.
+    Data(Arc<DataPattern>),
+}
+
+/// A `brightdata` (one grid) or `colordata` (three grids) pattern: coordinate
+/// expressions locate the ray in the grids, then the function(s) map the interpolated
+/// values (brightdata: `func(v)`; colordata: `rfunc(r,g,b)`, `gfunc(…)`, `bfunc(…)`).
+pub struct DataPattern {
+    exe: Compiled,
+    vars: Vec<VarId>,
+    coords: Vec<ExprId>,
+    funcs: Vec<FuncId>,
+    grids: Vec<DataGrid>,
+    fargs: Vec<f64>,
+}
+
+impl std::fmt::Debug for DataPattern {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("DataPattern")
+            .field("grids", &self.grids.len())
+            .field("fargs", &self.fargs)
+            .finish()
+    }
+}
+
+impl DataPattern {
+    fn eval(&self, q: &PatternInput) -> Result<DVec3> {
+        let mut st = self.exe.state();
+        st.set_all(&self.vars, &CalPattern::values(q));
+        st.set_fargs(&self.fargs);
+        let mut x = [0.0f64; 16];
+        for (k, e) in self.coords.iter().enumerate() {
+            x[k] = self
+                .exe
+                .eval_expr(&mut st, *e)
+                .map_err(|e| anyhow!("{e}"))?;
+        }
+        let x = &x[..self.coords.len()];
+        let v: Vec<f64> = self.grids.iter().map(|g| g.value(x)).collect();
+        let mut out = [0.0; 3];
+        for (k, f) in self.funcs.iter().enumerate() {
+            out[k] = self.exe.call(&mut st, *f, &v).map_err(|e| anyhow!("{e}"))?;
+        }
+        if self.funcs.len() == 1 {
+            out = [out[0]; 3];
+        }
+        Ok(DVec3::from_array(out))
+    }
 }
 
 impl Pattern {
@@ -136,6 +186,7 @@ impl Pattern {
             Pattern::Cie(s) => DVec3::splat(s.radiance(q.dir.to_array())),
             Pattern::Perez(p) => DVec3::splat(p.radiance(q.dir.to_array())),
             Pattern::Cal(c) => c.eval(q).unwrap_or(DVec3::ZERO),
+            Pattern::Data(d) => d.eval(q).unwrap_or(DVec3::ZERO),
         }
     }
 }
@@ -158,11 +209,14 @@ pub fn compile(scene: &Scene, k: usize, user: &str) -> Result<Pattern> {
         }
     }
     let what = format!("{}: {} '{}' (modifying '{user}')", q.loc, q.ptype, q.name);
+    if q.ptype == "brightdata" || q.ptype == "colordata" {
+        return compile_data(q, &what);
+    }
     let nexpr = match q.ptype.as_str() {
         "brightfunc" => 1,
         "colorfunc" => 3,
         other => bail!(
-            "{what}: fenestra's ray tracer evaluates brightfunc and colorfunc patterns; '{other}' is not supported yet"
+            "{what}: fenestra's ray tracer evaluates brightfunc, colorfunc, brightdata and colordata patterns; '{other}' is not supported yet"
         ),
     };
     if q.sargs.len() < nexpr + 1 {
@@ -178,4 +232,69 @@ pub fn compile(scene: &Scene, k: usize, user: &str) -> Result<Pattern> {
     let cp = CalPattern::new(&q.sargs[..nexpr], &q.sargs[nexpr], &q.rargs, &q.name)
         .map_err(|e| anyhow!("{what}: {e:#}"))?;
     Ok(Pattern::Cal(Arc::new(cp)))
+}
+
+/// `brightdata func data funcfile x1…xn` / `colordata rf gf bf rdata gdata bdata funcfile x1…xn`.
+fn compile_data(q: &fenestra_scene::Primitive, what: &str) -> Result<Pattern> {
+    let nf = if q.ptype == "brightdata" { 1 } else { 3 };
+    if q.sargs.len() < 2 * nf + 1 {
+        bail!("{what}: needs at least {} string arguments", 2 * nf + 1);
+    }
+    let mut grids = Vec::new();
+    for name in &q.sargs[nf..2 * nf] {
+        let path =
+            fenestra_cli::raypath::find_or_err(name).map_err(|e| anyhow!("{what}: {e:#}"))?;
+        grids.push(DataGrid::read(&path).map_err(|e| anyhow!("{what}: {e:#}"))?);
+    }
+    let dims = grids[0].dims();
+    if grids.iter().any(|g| g.dims() != dims) {
+        bail!("{what}: the data files have different numbers of dimensions");
+    }
+    let cal = &q.sargs[2 * nf];
+    let coords = &q.sargs[2 * nf + 1..];
+    if coords.len() < dims {
+        bail!(
+            "{what}: the data has {dims} dimension(s) but {} coordinate expression(s) follow the function file",
+            coords.len()
+        );
+    }
+    if coords.len() > dims {
+        bail!("{what}: transform arguments on patterns are not supported yet");
+    }
+    let mut p = Program::for_renderer();
+    let init =
+        fenestra_cli::raypath::find_or_err("rayinit.cal").map_err(|e| anyhow!("{what}: {e:#}"))?;
+    p.load_file(&init).map_err(|e| anyhow!("{what}: {e}"))?;
+    if cal != "." {
+        let path = fenestra_cli::raypath::find_or_err(cal).map_err(|e| anyhow!("{what}: {e:#}"))?;
+        p.load_file(&path).map_err(|e| anyhow!("{what}: {e}"))?;
+    }
+    let vars = p.bind_vars(&HOST_VARS);
+    let mut ids = Vec::new();
+    for e in coords {
+        ids.push(p.add_expr(&q.name, e).map_err(|e| anyhow!("{what}: {e}"))?);
+    }
+    let exe = p.compile().map_err(|e| anyhow!("{what}: {e}"))?;
+    let mut funcs = Vec::new();
+    for f in &q.sargs[..nf] {
+        funcs.push(exe.func(f).ok_or_else(|| {
+            anyhow!("{what}: '{f}' is not a function defined in rayinit.cal or {cal}")
+        })?);
+    }
+    let dp = DataPattern {
+        exe,
+        vars,
+        coords: ids,
+        funcs,
+        grids,
+        fargs: q.rargs.clone(),
+    };
+    let trial = PatternInput {
+        dir: DVec3::new(0.3, 0.4, 0.866_025_403_784_438_6),
+        point: DVec3::ZERO,
+        normal: DVec3::new(0.0, 0.0, -1.0),
+        dist: 1.0,
+    };
+    dp.eval(&trial).map_err(|e| anyhow!("{what}: {e}"))?;
+    Ok(Pattern::Data(Arc::new(dp)))
 }
