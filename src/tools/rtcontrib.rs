@@ -64,7 +64,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let (mut irr, mut value, mut header, mut warnings, mut overwrite, mut errors) =
         (false, false, true, true, false, false);
     let mut count = 1usize;
-    let (mut xres, mut yres, mut nproc, mut batches) = (0usize, 0usize, 1usize, 8usize);
+    let (mut xres, mut yres, mut nproc, mut batches) = (0usize, 0usize, 1usize, 4usize);
     let (mut fin, mut fout) = (InFormat::Ascii, Format::Ascii);
     let mut defs = CalcDefs::new();
     let mut cur_spec: Option<Spec> = None;
@@ -283,10 +283,6 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     if count == 0 {
         xres = 0;
         yres = 0;
-    }
-    // Standard errors with -c 1 come from independent batches of -ad/N samples each.
-    if errors && count == 1 {
-        o.ad = (o.ad / batches as u32).max(1);
     }
 
     let refs: Vec<&str> = files.iter().map(String::as_str).collect();
