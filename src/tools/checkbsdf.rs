@@ -1,8 +1,200 @@
-//! checkbsdf (being written; see the open issues).
+//! checkBSDF: report what a BSDF XML file holds — Radiance's report (header fields, per
+//! component the Lambertian part, largest directional total, angular resolution and
+//! reciprocity error), then fenestra's own section (hemispherical totals for normal and
+//! diffuse incidence, energy check). See docs/tools/checkBSDF.md.
 
+use std::fmt::Write as _;
+use std::io::Write;
+use std::path::Path;
 use std::process::ExitCode;
 
-/// Runs checkbsdf.
-pub fn run(_args: Vec<String>) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("not implemented yet")
+use anyhow::{anyhow, bail, Result};
+use fenestra_bsdf::check::{self, ComponentCheck, Reciprocity};
+use fenestra_bsdf::{BlockData, Bsdf, Direction, Wavelength};
+use fenestra_cli::opts::{Item, Spec};
+use fenestra_formats::matrix::format_c_g;
+
+fn spec() -> Spec {
+    Spec::new(
+        "checkBSDF",
+        "Report the contents of BSDF XML files (Radiance's summary, then hemispherical totals and an energy check)",
+    )
+    .usage("bsdf.xml ..")
+}
+
+/// Light gained beyond this fraction (T + R > 1 + this) is reported as not conserved:
+/// Monte Carlo BSDFs (genBSDF) carry noise of this order.
+const ENERGY_NOISE: f64 = 0.01;
+
+/// Runs checkBSDF.
+pub fn run(args: Vec<String>) -> Result<ExitCode> {
+    let items = spec().parse(&args)?;
+    let files: Vec<String> = items
+        .into_iter()
+        .filter_map(|i| match i {
+            Item::Pos(p) => Some(p),
+            Item::Opt(_) => None,
+        })
+        .collect();
+    if files.is_empty() {
+        bail!("usage: checkBSDF bsdf.xml ..");
+    }
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    for f in &files {
+        let path = fenestra_cli::raypath::find(f).unwrap_or_else(|| Path::new(f).into());
+        let b = fenestra_bsdf::read_file(&path).map_err(|e| anyhow!("{e}"))?;
+        let text = report(f, &b)?;
+        out.write_all(text.as_bytes())?;
+        out.flush()?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn g(v: f64, prec: usize) -> String {
+    let mut s = String::new();
+    format_c_g(&mut s, v, prec);
+    s
+}
+
+fn data_type(b: &Bsdf) -> String {
+    let Some(blk) = b.blocks.first() else {
+        return "Unknown".into();
+    };
+    match &blk.data {
+        BlockData::Tree(t) if t.rank() == 4 => "Anisotropic_Tensor_Tree".into(),
+        BlockData::Tree(_) => "Isotropic_Tensor_Tree".into(),
+        BlockData::Klems(m) => {
+            let n = m.incident.name().to_ascii_lowercase();
+            for (k, name) in [
+                ("full", "Klems_Full"),
+                ("half", "Klems_Half"),
+                ("quarter", "Klems_Quarter"),
+            ] {
+                if n.contains(k) {
+                    return name.into();
+                }
+            }
+            "Klems_Custom".into()
+        }
+    }
+}
+
+/// The report for one file.
+fn report(name: &str, b: &Bsdf) -> Result<String> {
+    let mut s = String::new();
+    s.push_str("=====================================================\n");
+    writeln!(s, "File: '{name}'")?;
+    writeln!(s, "Manufacturer: '{}'", b.manufacturer)?;
+    writeln!(s, "BSDF Name: '{}'", b.name)?;
+    let cm = |v: Option<f64>| g(v.unwrap_or(0.0) * 100.0, 6);
+    writeln!(
+        s,
+        "Dimensions (W x H x Thickness): {} x {} x {} cm",
+        cm(b.width),
+        cm(b.height),
+        cm(b.thickness)
+    )?;
+    writeln!(s, "Type: {}", data_type(b))?;
+    writeln!(s, "Color: {}", u8::from(b.has_colour()))?;
+    let geom = b
+        .geometry
+        .as_ref()
+        .is_some_and(|g| !g.mgf.trim().is_empty());
+    writeln!(s, "Has Geometry: {}", u8::from(geom))?;
+    if b.blocks
+        .iter()
+        .any(|blk| matches!(blk.data, BlockData::Tree(_)) && blk.wavelength == Wavelength::Visible)
+    {
+        bail!(
+            "{name}: tensor-tree data: the component analysis of checkBSDF is implemented for Klems matrices only"
+        );
+    }
+    let comp = |d| check::component(b, d);
+    let (rf, rb) = (
+        comp(Direction::ReflectionBack),
+        comp(Direction::ReflectionFront),
+    );
+    let (tf, tb) = (
+        comp(Direction::TransmissionBack),
+        comp(Direction::TransmissionFront),
+    );
+    s.push_str("Component\tLambertian XYZ (%)\tMax. Tot. Dir\tMin. Angle\n");
+    let row = |s: &mut String, label: &str, c: &Option<ComponentCheck>| {
+        let (l, m, a) = match c {
+            Some(c) => (c.lambertian_xyz, c.max_total, c.min_angle_deg),
+            None => ([0.0; 3], 0.0, 180.0),
+        };
+        let _ = writeln!(
+            s,
+            "{label}\t{:4.1} {:4.1} {:4.1}\t\t{:5.1}%\t\t{} deg",
+            100.0 * l[0],
+            100.0 * l[1],
+            100.0 * l[2],
+            100.0 * m,
+            g(a, 3)
+        );
+    };
+    row(&mut s, "Interior Refl", &rf);
+    row(&mut s, "Exterior Refl", &rb);
+    row(&mut s, "Int->Ext Trans", &tf);
+    if tf.is_none() && tb.is_none() {
+        s.push_str("Ext->Int Trans\t 0    0    0\t\t  0.0%\t\t180 deg\n");
+    } else {
+        row(&mut s, "Ext->Int Trans", &tb);
+    }
+    s.push_str("Component\tReciprocity Error (min avg max %)\n");
+    let rec = |s: &mut String, label: &str, r: Option<Reciprocity>| {
+        let _ = match r {
+            Some(r) => writeln!(
+                s,
+                "{label}\t{:5.1}\t{:5.1}\t{:5.1}",
+                100.0 * r.min,
+                100.0 * r.mean,
+                100.0 * r.max
+            ),
+            None => writeln!(s, "{label}\t  0\t  0\t  0"),
+        };
+    };
+    rec(
+        &mut s,
+        "Interior Refl",
+        check::reflection_reciprocity(b, Direction::ReflectionBack),
+    );
+    rec(
+        &mut s,
+        "Exterior Refl",
+        check::reflection_reciprocity(b, Direction::ReflectionFront),
+    );
+    rec(&mut s, "Transmission", check::transmission_reciprocity(b));
+
+    // fenestra's own section.
+    s.push_str("--- fenestra: hemispherical totals (Visible, fractions)\n");
+    s.push_str("Component\tNormal\tDiffuse\n");
+    for (label, c) in [
+        ("Interior Refl", &rf),
+        ("Exterior Refl", &rb),
+        ("Int->Ext Trans", &tf),
+        ("Ext->Int Trans", &tb),
+    ] {
+        match c {
+            Some(c) => writeln!(s, "{label}\t{:.4}\t{:.4}", c.normal_total, c.diffuse_total)?,
+            None => writeln!(s, "{label}\t-\t-")?,
+        }
+    }
+    for (exterior, side) in [(true, "exterior"), (false, "interior")] {
+        if let Some((v, i)) = check::energy_balance(b, exterior) {
+            writeln!(
+                s,
+                "Light from the {side}: largest T+R = {v:.4} (incident patch {i})"
+            )?;
+            if v > 1.0 + ENERGY_NOISE {
+                fenestra_cli::warn(format!(
+                    "{name}: energy not conserved for light from the {side}: T+R = {v:.4} at incident patch {i} (more than 1 + {ENERGY_NOISE})"
+                ));
+                writeln!(s, "WARNING: energy not conserved for light from the {side}")?;
+            }
+        }
+    }
+    Ok(s)
 }

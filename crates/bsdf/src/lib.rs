@@ -1,6 +1,7 @@
 //! fenestra-bsdf: Klems angle bases and BSDF data (LBNL/WINDOW 6 XML, Klems matrices and
 //! tensor trees), as Radiance reads and uses them.
 
+pub mod check;
 mod dom;
 pub mod klems;
 pub mod model;

@@ -1,0 +1,215 @@
+//! What `checkBSDF` reports about a Klems BSDF: per component the Lambertian part, the
+//! largest directional-hemispherical total, the angular resolution and the reciprocity
+//! error, plus hemispherical totals for normal and diffuse incidence and an energy check.
+//!
+//! Conventions (learned by running Radiance's checkBSDF): Radiance's "Interior Refl" is the
+//! XML `Reflection Back`, "Exterior Refl" `Reflection Front`, "Int->Ext Trans"
+//! `Transmission Back`, "Ext->Int Trans" `Transmission Front`. Values are the `Visible`
+//! (CIE Y) blocks. The reciprocity error of an element pair is `|a − b| / max(a, b)` (0 when
+//! both are 0) between `f(o ← i)` and `f'(rot(i) ← rot(o))`, rot = the same-ring patch turned
+//! by 180°, `f' = f` for reflection and `f'` = the opposite transmission block; min, mean and
+//! max are over all element pairs.
+
+use crate::klems::KlemsBasis;
+use crate::model::{Bsdf, Direction, KlemsMatrix, Wavelength};
+
+/// Radiance's threshold for splitting a matrix minimum off as a Lambertian part (sr⁻¹).
+pub const LAMBERTIAN_MIN: f64 = 0.01 / std::f64::consts::PI;
+
+/// Summary of one component (one XML direction).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ComponentCheck {
+    /// Lambertian part as CIE X, Y, Z hemispherical fractions (π × minimum; 0 below
+    /// [`LAMBERTIAN_MIN`]).
+    pub lambertian_xyz: [f64; 3],
+    /// Largest directional-hemispherical total over incident patches (fraction).
+    pub max_total: f64,
+    /// Angular resolution in degrees: `2·√(λ_min/π)` for the smallest projected solid angle.
+    pub min_angle_deg: f64,
+    /// Directional-hemispherical total at normal incidence (incident patch 0).
+    pub normal_total: f64,
+    /// Hemispherical-hemispherical total for diffuse incidence: `Σ_i λ_i·total(i) / π`.
+    pub diffuse_total: f64,
+    /// Directional-hemispherical total per incident patch.
+    pub totals: Vec<f64>,
+}
+
+/// Reciprocity error statistics (fractions).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Reciprocity {
+    /// Smallest element error.
+    pub min: f64,
+    /// Mean over all element pairs.
+    pub mean: f64,
+    /// Largest element error.
+    pub max: f64,
+}
+
+/// Summarises the `Visible` Klems matrix of `d`, `None` when the file has none.
+pub fn component(b: &Bsdf, d: Direction) -> Option<ComponentCheck> {
+    let y = b.klems(d, &Wavelength::Visible)?;
+    let min_of = |m: &KlemsMatrix| m.values.iter().copied().fold(f64::INFINITY, f64::min);
+    let ymin = min_of(y);
+    let lambertian_xyz = if ymin > LAMBERTIAN_MIN {
+        let pick = |w: Wavelength| b.klems(d, &w).map(min_of).unwrap_or(ymin);
+        [
+            std::f64::consts::PI * pick(Wavelength::CieX),
+            std::f64::consts::PI * ymin,
+            std::f64::consts::PI * pick(Wavelength::CieZ),
+        ]
+    } else {
+        [0.0; 3]
+    };
+    let totals: Vec<f64> = (0..y.incident.len()).map(|i| y.hemispherical(i)).collect();
+    let max_total = totals.iter().copied().fold(0.0, f64::max);
+    let lmin = |k: &KlemsBasis| k.lambdas().into_iter().fold(f64::INFINITY, f64::min);
+    let lam_min = lmin(&y.outgoing).min(lmin(&y.incident));
+    let min_angle_deg = (2.0 * (lam_min / std::f64::consts::PI).sqrt()).to_degrees();
+    let lam_in = y.incident.lambdas();
+    let diffuse_total =
+        totals.iter().zip(&lam_in).map(|(t, l)| t * l).sum::<f64>() / std::f64::consts::PI;
+    Some(ComponentCheck {
+        lambertian_xyz,
+        max_total,
+        min_angle_deg,
+        normal_total: totals.first().copied().unwrap_or(0.0),
+        diffuse_total,
+        totals,
+    })
+}
+
+fn pair_error(a: f64, b: f64) -> f64 {
+    let m = a.max(b);
+    if m > 0.0 {
+        (a - b).abs() / m
+    } else {
+        0.0
+    }
+}
+
+/// Reciprocity error of `f` against `g` (`f(o ← i)` vs `g(rot(i) ← rot(o))`); `None` when
+/// the bases do not allow the pairing (g's outgoing basis must be f's incident one and
+/// vice versa).
+pub fn reciprocity(f: &KlemsMatrix, g: &KlemsMatrix) -> Option<Reciprocity> {
+    if f.incident != g.outgoing || f.outgoing != g.incident {
+        return None;
+    }
+    let (ni, no) = (f.incident.len(), f.outgoing.len());
+    let rot_i: Vec<usize> = (0..ni)
+        .map(|i| f.incident.rotate180(i).unwrap_or(i))
+        .collect();
+    let rot_o: Vec<usize> = (0..no)
+        .map(|o| f.outgoing.rotate180(o).unwrap_or(o))
+        .collect();
+    let (mut lo, mut hi, mut sum) = (f64::INFINITY, 0.0f64, 0.0);
+    for (o, &ro) in rot_o.iter().enumerate() {
+        for (i, &ri) in rot_i.iter().enumerate() {
+            // g's outgoing index rot(i) lives in f's incident basis, its incident rot(o) in f's outgoing.
+            let e = pair_error(f.get(o, i), g.get(ri, ro));
+            lo = lo.min(e);
+            hi = hi.max(e);
+            sum += e;
+        }
+    }
+    let n = (ni * no).max(1) as f64;
+    Some(Reciprocity {
+        min: if lo.is_finite() { lo } else { 0.0 },
+        mean: sum / n,
+        max: hi,
+    })
+}
+
+/// Reciprocity of a reflection component with itself (`None` without that block).
+pub fn reflection_reciprocity(b: &Bsdf, d: Direction) -> Option<Reciprocity> {
+    let m = b.klems(d, &Wavelength::Visible)?;
+    reciprocity(m, m)
+}
+
+/// Reciprocity between the two transmission components (`None` unless both exist).
+pub fn transmission_reciprocity(b: &Bsdf) -> Option<Reciprocity> {
+    let f = b.klems(Direction::TransmissionFront, &Wavelength::Visible)?;
+    let g = b.klems(Direction::TransmissionBack, &Wavelength::Visible)?;
+    reciprocity(f, g)
+}
+
+/// The largest `T + R` over incident patches for light arriving on one side
+/// (`exterior`: XML `Transmission Front` + `Reflection Front`; otherwise the Back blocks),
+/// with the incident patch where it occurs. `None` when neither block exists or their
+/// incident bases differ.
+pub fn energy_balance(b: &Bsdf, exterior: bool) -> Option<(f64, usize)> {
+    let (t, r) = if exterior {
+        (Direction::TransmissionFront, Direction::ReflectionFront)
+    } else {
+        (Direction::TransmissionBack, Direction::ReflectionBack)
+    };
+    let t = component(b, t).map(|c| c.totals);
+    let r = component(b, r).map(|c| c.totals);
+    let sum: Vec<f64> = match (t, r) {
+        (None, None) => return None,
+        (Some(t), None) => t,
+        (None, Some(r)) => r,
+        (Some(t), Some(r)) => {
+            if t.len() != r.len() {
+                return None;
+            }
+            t.iter().zip(&r).map(|(a, b)| a + b).collect()
+        }
+    };
+    sum.iter().copied().enumerate().map(|(i, v)| (v, i)).fold(
+        None,
+        |best: Option<(f64, usize)>, x| match best {
+            Some(b) if b.0 >= x.0 => Some(b),
+            _ => Some(x),
+        },
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::{Block, BlockData};
+
+    fn lambertian(v: f64, d: Direction) -> Block {
+        let k = KlemsBasis::full().clone();
+        let n = k.len();
+        Block {
+            wavelength: Wavelength::Visible,
+            direction: d,
+            data_type: "BTDF".into(),
+            data: BlockData::Klems(KlemsMatrix {
+                incident: k.clone(),
+                outgoing: k,
+                values: vec![v; n * n],
+            }),
+        }
+    }
+
+    #[test]
+    fn lambertian_component() {
+        let v = 0.5 / std::f64::consts::PI;
+        let b = Bsdf {
+            blocks: vec![
+                lambertian(v, Direction::TransmissionFront),
+                lambertian(v, Direction::TransmissionBack),
+                lambertian(0.7 / std::f64::consts::PI, Direction::ReflectionFront),
+            ],
+            ..Default::default()
+        };
+        let c = component(&b, Direction::TransmissionFront).unwrap();
+        assert!((c.lambertian_xyz[1] - 0.5).abs() < 1e-12);
+        assert!((c.max_total - 0.5).abs() < 1e-9);
+        assert!((c.normal_total - 0.5).abs() < 1e-9);
+        assert!((c.diffuse_total - 0.5).abs() < 1e-9);
+        assert!(
+            (c.min_angle_deg - 8.562).abs() < 1e-3,
+            "{}",
+            c.min_angle_deg
+        );
+        let r = transmission_reciprocity(&b).unwrap();
+        assert_eq!((r.min, r.mean, r.max), (0.0, 0.0, 0.0));
+        let (e, _) = energy_balance(&b, true).unwrap();
+        assert!((e - 1.2).abs() < 1e-9);
+        assert!(energy_balance(&b, false).is_some());
+        assert!(reflection_reciprocity(&b, Direction::ReflectionBack).is_none());
+    }
+}
