@@ -186,3 +186,51 @@ wall polygon back 0 0 12  -2 5 3  2 5 3  2 5 0  -2 5 0
         );
     }
 }
+
+/// `-e` and `-f` definitions are visible to every pattern (Radiance's global context).
+#[test]
+fn oracle_e_and_f_reach_patterns() {
+    let Some(oracle) = common::oracle() else {
+        return;
+    };
+    let dir = common::scratch("patterns_ef");
+    std::fs::write(dir.join("defs.cal"), "shape(z) = 1 + gain*z*z;\n").unwrap();
+    std::fs::write(
+        dir.join("scene.rad"),
+        "void brightfunc sp 2 skyv . 0 0\nsp glow g 0 0 4 1 .8 .6 0\ng source s 0 0 4 0 0 1 180\n",
+    )
+    .unwrap();
+    let opts = [
+        "-h",
+        "-ab",
+        "0",
+        "-u-",
+        "-f",
+        "defs.cal",
+        "-e",
+        "gain=3;skyv=shape(Dz)",
+    ];
+    let rays: String = (0..10)
+        .map(|k| format!("0 0 0 {} 0 1\n", k as f64 * 0.3))
+        .collect();
+    let mut c = oracle.command("oconv");
+    c.arg("scene.rad").current_dir(&dir);
+    std::fs::write(dir.join("scene.oct"), common::run_ok(&mut c)).unwrap();
+    let mut theirs = oracle.command("rtrace");
+    theirs.args(opts).arg("scene.oct").current_dir(&dir);
+    let t = run(theirs, &rays);
+    assert!(t.status.success(), "{}", String::from_utf8_lossy(&t.stderr));
+    let mut ours = common::fenestra("rtrace");
+    ours.args(opts).arg("scene.rad").current_dir(&dir);
+    let o = run(ours, &rays);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (t, o) = (values(&t.stdout), values(&o.stdout));
+    assert_eq!(t.len(), 30);
+    assert_eq!(t.len(), o.len());
+    for (a, b) in t.iter().zip(&o) {
+        assert!(
+            (a - b).abs() <= 2e-5 * a.abs().max(1e-3),
+            "oracle {a} ours {b}"
+        );
+    }
+}

@@ -109,7 +109,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                     num(&args, i + 1)?;
                 }
                 "af" | "ai" | "ae" | "aI" | "aE" => {
-                    args.get(i + 1).with_context(|| format!("option {a} needs a value"))?;
+                    args.get(i + 1)
+                        .with_context(|| format!("option {a} needs a value"))?;
                 }
                 "x" => xres = num(&args, i + 1)?.max(0.0) as usize,
                 "y" => yres = num(&args, i + 1)?.max(0.0) as usize,
@@ -119,8 +120,21 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                     o.av = [num(&args, i + 1)?, num(&args, i + 2)?, num(&args, i + 3)?];
                     i += 2;
                 }
-                "e" | "f" => bail!("option {a}: .cal patterns are not supported by this build of fenestra's rtrace"),
-                _ => bail!("unknown option '{a}'\nusage: {} {USAGE}", fenestra_cli::prog()),
+                "e" | "f" => {
+                    let v = args
+                        .get(i + 1)
+                        .with_context(|| format!("option {a} needs an argument"))?
+                        .clone();
+                    o.cal.push(if name == "e" {
+                        fenestra_trace::options::CalSource::Expr(v)
+                    } else {
+                        fenestra_trace::options::CalSource::File(v)
+                    });
+                }
+                _ => bail!(
+                    "unknown option '{a}'\nusage: {} {USAGE}",
+                    fenestra_cli::prog()
+                ),
             }
             i += 1;
         }

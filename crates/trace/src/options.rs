@@ -33,6 +33,31 @@ pub struct TraceOptions {
     pub seed: u64,
     /// Disable effect selection (run the full integrator; for tests and benchmarks).
     pub full: bool,
+    /// `-e expr` and `-f file.cal` in command-line order: loaded after `rayinit.cal` and
+    /// before each pattern's own file, as Radiance's global calcomp context.
+    pub cal: Vec<CalSource>,
+}
+
+/// A command-line .cal source (`-e` or `-f`).
+#[derive(Debug, Clone, PartialEq)]
+pub enum CalSource {
+    /// `-e expr`.
+    Expr(String),
+    /// `-f file` (found through RAYPATH).
+    File(String),
+}
+
+impl CalSource {
+    /// Loads this source into a program.
+    pub fn load(&self, p: &mut fenestra_calc::Program) -> anyhow::Result<()> {
+        match self {
+            CalSource::Expr(e) => p.load_str("-e", e).map_err(|e| anyhow::anyhow!("{e}")),
+            CalSource::File(f) => {
+                let path = fenestra_cli::raypath::find_or_err(f)?;
+                p.load_file(&path).map_err(|e| anyhow::anyhow!("{e}"))
+            }
+        }
+    }
 }
 
 impl TraceOptions {
@@ -54,6 +79,7 @@ impl TraceOptions {
             av: [0.0; 3],
             seed: 0,
             full: false,
+            cal: Vec::new(),
         }
     }
 

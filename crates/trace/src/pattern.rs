@@ -12,6 +12,7 @@ use anyhow::{anyhow, bail, Result};
 use fenestra_calc::{Compiled, ExprId, FuncId, Program, VarId};
 
 use crate::datafile::DataGrid;
+use crate::options::CalSource;
 use fenestra_scene::Scene;
 use fenestra_sky::cie::SkyBright;
 use fenestra_sky::skyvec::PerezLum;
@@ -57,10 +58,19 @@ impl CalPattern {
     /// Compiles expressions `exprs` (1 for brightfunc, 3 for colorfunc) over .cal file
     /// `cal` (`.` for none, found through RAYPATH), with `rayinit.cal` loaded first and
     /// `fargs` as `arg(n)`. A trial evaluation reports undefined names now.
-    pub fn new(exprs: &[String], cal: &str, fargs: &[f64], label: &str) -> Result<CalPattern> {
+    pub fn new(
+        exprs: &[String],
+        cal: &str,
+        fargs: &[f64],
+        label: &str,
+        user: &[CalSource],
+    ) -> Result<CalPattern> {
         let mut p = Program::for_renderer();
         let init = fenestra_cli::raypath::find_or_err("rayinit.cal")?;
         p.load_file(&init).map_err(|e| anyhow!("{e}"))?;
+        for c in user {
+            c.load(&mut p)?;
+        }
         if cal != "." {
             let path = fenestra_cli::raypath::find_or_err(cal)?;
             p.load_file(&path).map_err(|e| anyhow!("{e}"))?;
@@ -192,7 +202,8 @@ impl Pattern {
 }
 
 /// Compiles pattern primitive `k` (used by material `user` for messages).
-pub fn compile(scene: &Scene, k: usize, user: &str) -> Result<Pattern> {
+/// `cal` holds the command line's `-e`/`-f` definitions.
+pub fn compile(scene: &Scene, k: usize, user: &str, cal: &[CalSource]) -> Result<Pattern> {
     let q = &scene.prims[k];
     let file = |s: &str| s.rsplit('/').next().unwrap_or(s).to_string();
     if q.ptype == "brightfunc" && q.sargs.len() == 2 {
@@ -210,7 +221,7 @@ pub fn compile(scene: &Scene, k: usize, user: &str) -> Result<Pattern> {
     }
     let what = format!("{}: {} '{}' (modifying '{user}')", q.loc, q.ptype, q.name);
     if q.ptype == "brightdata" || q.ptype == "colordata" {
-        return compile_data(q, &what);
+        return compile_data(q, &what, cal);
     }
     let nexpr = match q.ptype.as_str() {
         "brightfunc" => 1,
@@ -229,13 +240,13 @@ pub fn compile(scene: &Scene, k: usize, user: &str) -> Result<Pattern> {
     if q.sargs.len() > nexpr + 1 {
         bail!("{what}: transform arguments on patterns are not supported yet");
     }
-    let cp = CalPattern::new(&q.sargs[..nexpr], &q.sargs[nexpr], &q.rargs, &q.name)
+    let cp = CalPattern::new(&q.sargs[..nexpr], &q.sargs[nexpr], &q.rargs, &q.name, cal)
         .map_err(|e| anyhow!("{what}: {e:#}"))?;
     Ok(Pattern::Cal(Arc::new(cp)))
 }
 
 /// `brightdata func data funcfile x1…xn` / `colordata rf gf bf rdata gdata bdata funcfile x1…xn`.
-fn compile_data(q: &fenestra_scene::Primitive, what: &str) -> Result<Pattern> {
+fn compile_data(q: &fenestra_scene::Primitive, what: &str, user: &[CalSource]) -> Result<Pattern> {
     let nf = if q.ptype == "brightdata" { 1 } else { 3 };
     if q.sargs.len() < 2 * nf + 1 {
         bail!("{what}: needs at least {} string arguments", 2 * nf + 1);
@@ -265,6 +276,9 @@ fn compile_data(q: &fenestra_scene::Primitive, what: &str) -> Result<Pattern> {
     let init =
         fenestra_cli::raypath::find_or_err("rayinit.cal").map_err(|e| anyhow!("{what}: {e:#}"))?;
     p.load_file(&init).map_err(|e| anyhow!("{what}: {e}"))?;
+    for c in user {
+        c.load(&mut p).map_err(|e| anyhow!("{what}: {e:#}"))?;
+    }
     if cal != "." {
         let path = fenestra_cli::raypath::find_or_err(cal).map_err(|e| anyhow!("{what}: {e:#}"))?;
         p.load_file(&path).map_err(|e| anyhow!("{what}: {e}"))?;

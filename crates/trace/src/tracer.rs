@@ -161,7 +161,7 @@ impl Tracer {
             }
             let mut pats = Vec::new();
             for k in scene.modifier_chain(m) {
-                pats.push(crate::pattern::compile(scene, k, &p.name)?);
+                pats.push(crate::pattern::compile(scene, k, &p.name, &opts.cal)?);
             }
             if !pats.is_empty() {
                 patterns.insert(m, pats);
