@@ -13,9 +13,9 @@
 
 pub mod bsdf_mat;
 pub mod bvh;
+pub mod datafile;
 pub mod material;
 pub mod options;
-pub mod datafile;
 pub mod pattern;
 pub mod polygon;
 pub mod rng;
