@@ -704,3 +704,49 @@ fn error_estimates_from_accumulated_rays() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("-Eo"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn native_bins_give_the_same_bytes_as_the_cal_files() {
+    // kbinS and rbin are evaluated natively when fenestra's own klems_full.cal /
+    // reinhart.cal are loaded; FENESTRA_NO_NATIVE_BINS forces the .cal evaluator.
+    let pts = std::fs::read(common::fixture("rtrace_threephase_bsdf").join("sensors.pts")).unwrap();
+    let scene = office_scene();
+    for bins in [
+        vec!["-f", "klems_full.cal", "-b", "kbinS", "-bn", "Nkbins"],
+        vec![
+            "-e",
+            "MF:2",
+            "-f",
+            "reinhart.cal",
+            "-b",
+            "rbin",
+            "-bn",
+            "Nrbins",
+        ],
+        vec![
+            "-f",
+            "klems_full.cal",
+            "-p",
+            "RHS=-1",
+            "-b",
+            "kbin(0,1,0,0,0,1)",
+            "-bn",
+            "145",
+        ],
+    ] {
+        let run = |native: bool| {
+            let mut a = vec!["-h", "-I+", "-ab", "2", "-ad", "300", "-lw", "1e-3", "-fad"];
+            a.extend(&bins);
+            a.extend(["-m", "SouthGroup"]);
+            a.extend(scene.iter().map(String::as_str));
+            let mut c = rc(&a);
+            if !native {
+                c.env("FENESTRA_NO_NATIVE_BINS", "1");
+            }
+            ok(c, &pts)
+        };
+        let n = run(true);
+        assert!(n.iter().any(|&b| b != 0));
+        assert_eq!(n, run(false), "{bins:?}");
+    }
+}

@@ -8,10 +8,12 @@ use anyhow::{anyhow, bail, Context, Result};
 use fenestra_calc::{Compiled, ExprId, Program, State, VarId};
 
 /// Host variables set from the ray that reached a tracked surface, in this order.
-pub const RAY_VARS: [&str; 27] = [
+pub const RAY_VARS: [&str; 31] = [
     "Dx", "Dy", "Dz", "Nx", "Ny", "Nz", "Px", "Py", "Pz", "T", "Ts", "Rdot", "S", "Tx", "Ty", "Tz",
-    "Ix", "Iy", "Iz", "Jx", "Jy", "Jz", "Kx", "Ky", "Kz", "Lu", "Lv",
+    "Ix", "Iy", "Iz", "Jx", "Jy", "Jz", "Kx", "Ky", "Kz", "Lu", "Lv", "NxP", "NyP", "NzP", "RdotP",
 ];
+
+use crate::native::{self, NativeBin};
 
 /// One definition source, in command-line order.
 #[derive(Debug, Clone)]
@@ -103,6 +105,63 @@ impl CalcDefs {
         Ok(p)
     }
 
+    /// Whether `expr` may be evaluated natively: it is a Klems `kbin…` or `rbin` expression,
+    /// the matching file loaded is fenestra's own (byte-identical), and no other definition
+    /// (or `-p` name) defines any name the file uses.
+    fn native_allowed(&self, expr: &str, params: &[(String, f64)]) -> bool {
+        if std::env::var_os("FENESTRA_NO_NATIVE_BINS").is_some() {
+            return false;
+        }
+        let (text, names): (&str, &[&str]) = if native::klems_frame(expr).is_some() {
+            (native::KLEMS_FULL_CAL, &native::KLEMS_NAMES)
+        } else if expr.trim() == "rbin" {
+            (native::REINHART_CAL, &native::REINHART_NAMES)
+        } else {
+            return false;
+        };
+        let is_ours = |p: &PathBuf| std::fs::read_to_string(p).is_ok_and(|t| t == text);
+        let Some(k) = self
+            .defs
+            .iter()
+            .rposition(|d| matches!(d, Def::File(f) if is_ours(f)))
+        else {
+            return false;
+        };
+        let bad = |name: &str| names.contains(&name) || native::BUILTINS_USED.contains(&name);
+        if params.iter().any(|(n, _)| bad(n)) {
+            return false;
+        }
+        let others = self
+            .defs
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| *i != k)
+            .map(|(_, d)| d.clone())
+            .chain(self.rayinit.iter().map(|r| Def::File(r.clone())));
+        for d in others {
+            let mut p = Program::new();
+            let ok = match &d {
+                Def::Expr(t) => p.load_str("-e", t).is_ok(),
+                Def::File(f) => p.load_file(f).is_ok(),
+                Def::Param(n, _) => {
+                    if bad(n) {
+                        return false;
+                    }
+                    continue;
+                }
+            };
+            if !ok
+                || names
+                    .iter()
+                    .chain(native::BUILTINS_USED.iter())
+                    .any(|n| p.is_defined(n))
+            {
+                return false;
+            }
+        }
+        true
+    }
+
     /// Evaluates an expression with the definitions seen so far (rcontrib's `-bn`).
     pub fn eval_now(&self, expr: &str) -> Result<f64> {
         let mut p = self.program()?;
@@ -116,8 +175,8 @@ impl CalcDefs {
     }
 }
 
-fn ray_values_default() -> [f64; 27] {
-    let mut v = [0.0; 27];
+fn ray_values_default() -> [f64; 31] {
+    let mut v = [0.0; 31];
     v[12] = 1.0; // S
     v[16] = 1.0; // Ix
     v[20] = 1.0; // Jy
@@ -126,7 +185,7 @@ fn ray_values_default() -> [f64; 27] {
 }
 
 /// Values of [`RAY_VARS`] for a ray.
-pub fn ray_values(c: &fenestra_trace::Contribution) -> [f64; 27] {
+pub fn ray_values(c: &fenestra_trace::Contribution) -> [f64; 31] {
     let mut v = ray_values_default();
     v[0..3].copy_from_slice(&c.dir.to_array());
     v[3..6].copy_from_slice(&c.normal.to_array());
@@ -134,12 +193,17 @@ pub fn ray_values(c: &fenestra_trace::Contribution) -> [f64; 27] {
     v[9] = c.total_dist;
     v[10] = c.dist;
     v[11] = (-c.dir.dot(c.normal)).clamp(-1.0, 1.0);
+    // no perturbed normals (textures) in bin evaluation: NxP.. = Nx.., RdotP = Rdot
+    v[27..30].copy_from_slice(&c.normal.to_array());
+    v[30] = v[11];
     v
 }
 
 /// Compiled bin expressions: one program per distinct `-p` parameter set.
 pub struct Bins {
     groups: Vec<(Compiled, Vec<VarId>)>,
+    /// Per modifier: the native evaluation of its bin expression, when allowed.
+    natives: Vec<Option<NativeBin>>,
     /// Per modifier: `None` for the constant bin 0, else (group, expression).
     exprs: Vec<Option<(usize, ExprId)>>,
 }
@@ -192,8 +256,41 @@ impl Bins {
         for (p, vars) in progs {
             groups.push((p.compile().map_err(|e| anyhow!("{e}"))?, vars));
         }
+        let mut natives = Vec::new();
+        for (r, pl) in reqs.iter().zip(&placed) {
+            let nb = match pl {
+                Some((g, _)) if defs.native_allowed(r.expr, r.params) => {
+                    let (exe, vars) = &groups[*g];
+                    // a constant of the program: the same for any ray values
+                    let konst = |name: &str| -> Option<f64> {
+                        let v = exe.var(name)?;
+                        let mut out = None;
+                        for fill in [f64::NAN, 0.3, -0.7] {
+                            let mut st = exe.state();
+                            st.set_all(vars, &[fill; 31]);
+                            let x = exe.eval_var(&mut st, v).ok()?;
+                            if !x.is_finite() || out.is_some_and(|o| o != x) {
+                                return None;
+                            }
+                            out = Some(x);
+                        }
+                        out
+                    };
+                    if let Some((n, u)) = native::klems_frame(r.expr) {
+                        konst("RHS").map(|rhs| NativeBin::Klems { n, u, rhs })
+                    } else {
+                        konst("MF")
+                            .filter(|m| *m >= 1.0 && m.fract() == 0.0)
+                            .map(|mf| NativeBin::Reinhart { mf })
+                    }
+                }
+                _ => None,
+            };
+            natives.push(nb);
+        }
         Ok(Bins {
             groups,
+            natives,
             exprs: placed,
         })
     }
@@ -203,8 +300,26 @@ impl Bins {
         self.groups.iter().map(|(c, _)| c.state()).collect()
     }
 
+    /// Whether modifier `m`'s bin expression is evaluated natively.
+    pub fn is_native(&self, m: usize) -> bool {
+        self.natives[m].is_some()
+    }
+
+    /// The bin value of modifier `m` for a contribution (not yet rounded).
+    pub fn eval_for(
+        &self,
+        m: usize,
+        c: &fenestra_trace::Contribution,
+        states: &mut [State],
+    ) -> Result<f64> {
+        if let Some(nb) = &self.natives[m] {
+            return Ok(nb.eval(c.dir));
+        }
+        self.eval(m, &ray_values(c), states)
+    }
+
     /// The bin value of modifier `m` for a ray (not yet rounded).
-    pub fn eval(&self, m: usize, vals: &[f64; 27], states: &mut [State]) -> Result<f64> {
+    pub fn eval(&self, m: usize, vals: &[f64; 31], states: &mut [State]) -> Result<f64> {
         let Some((g, id)) = self.exprs[m] else {
             return Ok(0.0);
         };

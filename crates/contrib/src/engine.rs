@@ -10,7 +10,7 @@ use fenestra_calc::State;
 use fenestra_trace::{Contribution, DVec3, Tracer};
 use rayon::prelude::*;
 
-use crate::calc::{ray_values, Bins};
+use crate::calc::Bins;
 
 /// Input data format (`-fi`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -226,8 +226,7 @@ impl<'a> Engine<'a> {
                 return;
             }
             let b = if self.bins.varies(m) {
-                let vals = ray_values(&c);
-                match self.bins.eval(m, &vals, states) {
+                match self.bins.eval_for(m, &c, states) {
                     Ok(bv) => {
                         if bv <= -0.5 || bv.is_nan() {
                             return;

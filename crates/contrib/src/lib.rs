@@ -4,4 +4,5 @@
 
 pub mod calc;
 pub mod engine;
+pub mod native;
 pub mod output;
