@@ -517,3 +517,78 @@ fn oracle_pcomb_of_dctimestep_pictures() {
     assert_eq!(pa.res, pb.res);
     assert_eq!(pa.pixels, pb.pixels);
 }
+
+/// Picture form over 56 time steps: per-step files (`-o i%02d.hdr`, FRAME=i) and one stream (a
+/// full header before the first frame, then `FRAME=i`, FORMAT and resolution before each
+/// later one) as the oracle writes them; `-h` leaves picture headers on, as in Radiance.
+/// Pixels within one RGBE mantissa step (Radiance sums the components in float, alternating
+/// the order from step to step).
+#[test]
+fn oracle_picture_form_time_steps() {
+    let Some(o) = common::oracle() else { return };
+    let fx = common::fixture("threephase");
+    let args: Vec<String> = vec![
+        "-o".into(),
+        "i%02d.hdr".into(),
+        fx.join("vimg/v%03d.hdr").display().to_string(),
+        fx.join("T.mtx").display().to_string(),
+        fx.join("D.dmx").display().to_string(),
+        fx.join("test.m1.smx").display().to_string(),
+    ];
+    let (da, db) = (
+        common::scratch("dctimestep-frames-a"),
+        common::scratch("dctimestep-frames-b"),
+    );
+    let mut a = common::fenestra("dctimestep");
+    a.current_dir(&da).args(&args);
+    run(a);
+    let mut b = o.command("dctimestep");
+    b.current_dir(&db).args(&args);
+    run(b);
+    let read = |p: PathBuf| {
+        let bytes = std::fs::read(&p).unwrap();
+        let pic = fenestra_formats::picture::Picture::read(&mut &bytes[..], "t").unwrap();
+        (split(&bytes).0, pic)
+    };
+    for t in 0..56 {
+        let name = format!("i{t:02}.hdr");
+        let ((ha, pa), (hb, pb)) = (read(da.join(&name)), read(db.join(&name)));
+        assert_eq!(ha, hb, "{name}: header");
+        assert_eq!(pa.res, pb.res);
+        for (x, y) in pa.pixels.iter().zip(&pb.pixels) {
+            for c in 0..3 {
+                let m = x[c].max(y[c]);
+                assert!(
+                    (x[c] - y[c]).abs() <= m / 128.0 + 1e-30,
+                    "{name}: {x:?} vs {y:?}"
+                );
+            }
+        }
+    }
+    // One stream, with and without -h.
+    for h in [false, true] {
+        let mut v: Vec<&str> = Vec::new();
+        if h {
+            v.push("-h");
+        }
+        v.extend(["vimg/v%03d.hdr", "T.mtx", "D.dmx", "test.m1.smx"]);
+        let mut a = ours();
+        a.args(&v);
+        let mut b = oracle_cmd(&o);
+        b.args(&v);
+        let (ra, rb) = (run(a), run(b));
+        let count = |d: &[u8], pat: &[u8]| d.windows(pat.len()).filter(|w| *w == pat).count();
+        assert_eq!(count(&ra, b"#?RADIANCE"), 1);
+        assert_eq!(count(&ra, b"FRAME="), 56);
+        assert_eq!(
+            count(
+                &ra,
+                b"\nFORMAT=32-bit_rle_rgbe\n\n-Y       26 +X       32\n"
+            ),
+            56
+        );
+        assert_eq!(count(&rb, b"FRAME="), 56);
+        assert_eq!(split(&ra).0, split(&rb).0, "first header");
+        assert_eq!(ra.len(), rb.len());
+    }
+}

@@ -159,6 +159,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             fenestra_cli::warn("changing output type to -oc");
         }
         o.out_fmt = DataFormat::Rgbe;
+        // Radiance writes picture headers whatever -h says.
+        o.header = true;
         return picture_form(&vspec, td.map(|t| t.0), &sky, &o);
     }
     let td = td.map(|t| t.0);
@@ -841,7 +843,14 @@ fn picture_form(vspec: &str, td: Option<Planar>, sky: &PackedSky, o: &Opts) -> R
         let (w, h) = (res.scanlen(), res.numscans());
         let (oh, ow) = reshape(h, w, o)?;
         let frame = (steps > 1).then_some(t);
-        let mut hb = header_bytes(o, frame, oh, ow, None);
+        let mut hb = if per_step.is_none() && t > 0 && o.header {
+            // Later frames in one stream: Radiance writes only FRAME, FORMAT and the resolution.
+            let mut b = format!("FRAME={t}\nFORMAT=32-bit_rle_rgbe\n\n").into_bytes();
+            b.extend_from_slice(Resolution::standard(ow, oh).to_string().as_bytes());
+            b
+        } else {
+            header_bytes(o, frame, oh, ow, None)
+        };
         if (oh, ow) == (h, w) {
             // Keep the pictures' own orientation.
             let std = Resolution::standard(w, h).to_string();
