@@ -14,12 +14,17 @@ use fenestra_formats::picture::{
 use fenestra_formats::rgbe;
 use fenestra_formats::view::View;
 
+#[path = "pcomb_expr.rs"]
+mod expr;
+use expr::{ExprInput, Exprs, Source};
+use std::sync::Arc;
+
 fn spec() -> Spec {
     Spec::new(
         "pcomb",
         "Combine Radiance pictures (sum, scale, colour) to the standard output",
     )
-    .usage("[-h][-w][-ff][-x xres][-y yres] [[-o][-s factor][-c r g b] input ..]")
+    .usage("[-h][-w][-ff][-x xres][-y yres][-e expr][-f file] [[-o][-s factor][-c r g b] input ..]")
     .interleaved(true)
     .opt(Opt::new(
         "h",
@@ -45,12 +50,12 @@ fn spec() -> Spec {
     .opt(Opt::new(
         "e",
         Kind::Word,
-        "expression (not supported by this fenestra build)",
+        "expression defining ro go bo (or lo) from ri(n) gi(n) bi(n) li(n), x, y …",
     ))
     .opt(Opt::new(
         "f",
         Kind::Word,
-        "file of expressions (not supported by this fenestra build)",
+        "file of expressions (found through RAYPATH)",
     ))
     .opt(Opt::new(
         "o",
@@ -78,6 +83,8 @@ struct Input {
     pixels: Vec<[f32; 3]>,
     view: Option<View>,
     original: bool,
+    exposure: f64,
+    aspect: f64,
 }
 
 /// Runs pcomb.
@@ -88,19 +95,18 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let mut coef = [1f32; 3];
     let mut original = false;
     let mut inputs: Vec<Input> = Vec::new();
+    let mut sources: Vec<Source> = Vec::new();
+    let (mut xword, mut yword) = (None, None);
     for it in &items {
         match it {
             Item::Opt(h) => match h.key {
                 "h" => echo = !echo,
                 "w" => {}
                 "ff" => float_out = true,
-                "x" => xopt = Some(parse_res(h.word(), "x")?),
-                "y" => yopt = Some(parse_res(h.word(), "y")?),
-                "e" | "f" => bail!(
-                    "option -{} (expressions) is not supported by fenestra's pcomb; \
-                     only sums with -s, -c and -o are",
-                    h.key
-                ),
+                "x" => xword = Some(h.word().to_string()),
+                "y" => yword = Some(h.word().to_string()),
+                "e" => sources.push(Source::Expr(h.word().to_string())),
+                "f" => sources.push(Source::File(h.word().to_string())),
                 "o" => original = true,
                 "s" => {
                     let s = h.real();
@@ -155,6 +161,12 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         .first()
         .map(|i| (i.width, i.height))
         .unwrap_or((0, 0));
+    if let Some(w) = &xword {
+        xopt = Some(parse_res(w, "x", &sources, xmax, ymax)?);
+    }
+    if let Some(w) = &yword {
+        yopt = Some(parse_res(w, "y", &sources, xmax, ymax)?);
+    }
     let xres = xopt.unwrap_or(xmax);
     let yres = yopt.unwrap_or(ymax);
     if xres == 0 || yres == 0 {
@@ -201,6 +213,28 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         head.push_str(&fenestra_formats::resolution::Resolution::standard(xres, yres).to_string());
     }
 
+    let data: Arc<Vec<ExprInput>> = Arc::new(
+        inputs
+            .into_iter()
+            .map(|i| ExprInput {
+                width: i.width,
+                height: i.height,
+                pixels: i.pixels,
+                // -o undoes the exposure, and le(n) then reports 1 (as Radiance's).
+                exposure: if i.original { 1.0 } else { i.exposure },
+                aspect: i.aspect,
+            })
+            .collect(),
+    );
+    let mut exprs = if sources.is_empty() {
+        None
+    } else {
+        let mut e = Exprs::new(&sources, data.clone(), xres, yres)?;
+        // Undefined names surface on the first evaluation: try one pixel before any
+        // output is written, so an error leaves no partial picture.
+        e.pixel(0, 0, [0.0; 3])?;
+        Some(e)
+    };
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::with_capacity(1 << 16, stdout.lock());
     out.write_all(head.as_bytes())?;
@@ -215,11 +249,16 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         for (x, px) in row.iter_mut().enumerate() {
             let xin = ((x as f64 + 0.5) * xmax as f64 / xres as f64) as usize;
             let mut sum = [0f64; 3];
-            for inp in &inputs {
+            for inp in data.iter() {
                 let p = inp.pixels[rin * inp.width + xin];
                 for k in 0..3 {
                     sum[k] += p[k] as f64;
                 }
+            }
+            if let Some(e) = exprs.as_mut() {
+                sum = e
+                    .pixel(x, y, sum)
+                    .with_context(|| format!("pixel ({x}, {y})"))?;
             }
             for k in 0..3 {
                 px[k] = if !float_out && sum[k] < 0.0 {
@@ -248,13 +287,39 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn parse_res(w: &str, axis: &str) -> Result<usize> {
-    match fenestra_cli::opts::parse_int(w) {
-        Some(v) if v > 0 => Ok(v as usize),
-        _ => bail!(
-            "-{axis} {w}: expected a positive integer resolution \
-             (resolution expressions need -e support, which fenestra's pcomb lacks)"
-        ),
+/// An output resolution: an integer, or an expression over `xmax`/`ymax` and the
+/// `-e`/`-f` definitions (as Radiance's pcomb evaluates `-x`/`-y`).
+fn parse_res(w: &str, axis: &str, sources: &[Source], xmax: usize, ymax: usize) -> Result<usize> {
+    if let Some(v) = fenestra_cli::opts::parse_int(w) {
+        if v > 0 {
+            return Ok(v as usize);
+        }
+        bail!("-{axis} {w}: the resolution must be positive");
+    }
+    let mut p = fenestra_calc::Program::new();
+    p.set_number("xmax", xmax as f64);
+    p.set_number("ymax", ymax as f64);
+    p.set_number("PI", std::f64::consts::PI);
+    for s in sources {
+        match s {
+            Source::Expr(e) => p.load_str("-e", e).map_err(|e| anyhow::anyhow!("{e}"))?,
+            Source::File(f) => {
+                let path = fenestra_cli::raypath::find_or_err(f)?;
+                p.load_file(&path).map_err(|e| anyhow::anyhow!("{e}"))?;
+            }
+        }
+    }
+    let e = p
+        .add_expr(&format!("-{axis}"), w)
+        .map_err(|e| anyhow::anyhow!("{e}"))?;
+    let exe = p.compile().map_err(|e| anyhow::anyhow!("{e}"))?;
+    let v = exe
+        .eval_expr(&mut exe.state(), e)
+        .map_err(|e| anyhow::anyhow!("-{axis} {w}: {e}"))?;
+    if v >= 0.5 && v < 1e8 {
+        Ok((v + 0.5) as usize)
+    } else {
+        bail!("-{axis} {w}: the resolution evaluates to {v}")
     }
 }
 
@@ -294,6 +359,8 @@ fn read_input(name: &str) -> Result<Input> {
                 width: w,
                 height: h,
                 pixels: px,
+                exposure: info.exposure,
+                aspect: info.pixaspect,
                 view: info.view,
                 original: false,
             })
@@ -303,6 +370,7 @@ fn read_input(name: &str) -> Result<Input> {
                 .with_context(|| format!("input '{name}'"))?;
             let res = read_resolution(&mut r).with_context(|| format!("input '{name}'"))?;
             let pixels = read_pixels(&mut r, &res).with_context(|| format!("input '{name}'"))?;
+            let (exposure, aspect) = (info.exposure, info.pixaspect);
             let mut view = info.view;
             if let Some(v) = view.as_mut() {
                 if v.setup().is_err() {
@@ -317,6 +385,8 @@ fn read_input(name: &str) -> Result<Input> {
                 pixels,
                 view,
                 original: false,
+                exposure,
+                aspect,
             })
         }
     }
