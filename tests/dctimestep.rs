@@ -592,3 +592,29 @@ fn oracle_picture_form_time_steps() {
         assert_eq!(ra.len(), rb.len());
     }
 }
+
+/// A Reinhart MF 2 sky (578 patches) with the MF 1 daylight matrix is an error naming both
+/// files and sizes; a sun-only MF 1 sky vector agrees with the oracle to print precision.
+#[test]
+fn mf2_sky_rejected_and_sun_only_sky() {
+    let m2 = common::fixture("sky/s01_clear_sun_sf_equinox_noon.m2.skv");
+    let mut c = ours();
+    c.args(["V.vmx", "T.mtx", "D.dmx"]).arg(&m2);
+    let out = c.output().unwrap();
+    assert!(!out.status.success());
+    assert!(out.stdout.is_empty());
+    let err = String::from_utf8_lossy(&out.stderr);
+    for w in ["m2.skv", "578 rows", "D.dmx", "146 columns"] {
+        assert!(err.contains(w), "'{err}' lacks '{w}'");
+    }
+    let Some(o) = common::oracle() else { return };
+    let sun = common::fixture("sky/s01_clear_sun_sf_equinox_noon.m1.sunonly.skv");
+    let mut a = ours();
+    a.args(["V.vmx", "T.mtx", "D.dmx"]).arg(&sun);
+    let mut b = oracle_cmd(&o);
+    b.args(["V.vmx", "T.mtx", "D.dmx"]).arg(&sun);
+    let (ra, rb) = (split(&run(a)), split(&run(b)));
+    assert_eq!(ra.0[2..], rb.0[2..]);
+    let w = worst_rel(&ascii(&ra.1), &ascii(&rb.1));
+    assert!(w < PRINT_TOL, "sun only: {w}");
+}
