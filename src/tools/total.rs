@@ -1,8 +1,542 @@
-//! total (being written; see the open issues).
+//! total: sums (means, powers, products, extrema) of the columns of text or binary records,
+//! with Radiance's command line and output (`%.9g`, tab-separated).
 
+use std::io::{BufRead, Write};
 use std::process::ExitCode;
 
+use anyhow::{bail, Context, Result};
+use fenestra_formats::matrix::format_c_g;
+
+const USAGE: &str = "Usage: total [-m][-sE|p|u|l][-tC][-i{f|d}[N]][-o{f|d}][-count [-r]] [file..]";
+
+const HELP: &str = "total: column sums, means, products and extrema of records
+
+Usage: total [-m][-sE|p|u|l][-tC][-i{f|d}[N]][-o{f|d}][-count [-r]] [file..]
+
+  -m        means instead of sums (with -sE: (mean of |x|^E)^(1/E); with -p: geometric mean)
+  -sE       sum |x|^E over non-zero x (E = 0 or none: plain sum)
+  -p        products
+  -u, -l    maxima, minima
+  -tC       fields separated by the character C (default: white space); output uses C too
+  -if[N]    binary input: records of N floats (default 1); -id[N] doubles
+  -of, -od  binary output: floats or doubles
+  -N        a result for every N records (the last, shorter batch too)
+  -r        with -N: running results (accumulate over all records)
+
+Text input: one record per line; a blank line ends a set of records, whose result is printed
+(a blank line straight after a printed result ends the input). Each file gives its own results;
+no file (or '-') reads the standard input. Unparsable fields count as 0, as in Radiance.
+";
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Mode {
+    Sum,
+    Power(f64),
+    Product,
+    Max,
+    Min,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Binary {
+    Float,
+    Double,
+}
+
+#[derive(Debug, Clone)]
+struct Opts {
+    mean: bool,
+    mode: Mode,
+    sep: Option<char>,
+    input: Option<(Binary, usize)>,
+    output: Option<Binary>,
+    count: usize,
+    running: bool,
+}
+
+/// Largest magnitude extrema start from (as Radiance's total).
+const HUGE: f64 = 1e12;
+
+fn parse(args: &[String]) -> Result<(Opts, Vec<String>)> {
+    let mut o = Opts {
+        mean: false,
+        mode: Mode::Sum,
+        sep: None,
+        input: None,
+        output: None,
+        count: 0,
+        running: false,
+    };
+    let mut files = Vec::new();
+    for (i, a) in args.iter().enumerate().skip(1) {
+        if a == "--help" || a == "-help" {
+            print!("{HELP}");
+            return Err(fenestra_cli::Exit(0).into());
+        }
+        if !a.starts_with('-') || a == "-" {
+            files.extend(args[i..].iter().cloned());
+            break;
+        }
+        let body = &a[1..];
+        let bad = || anyhow::anyhow!("bad option '{a}'\n{USAGE}");
+        match body.chars().next() {
+            Some('m') if body == "m" => o.mean = !o.mean,
+            Some('s') => {
+                let e = atof(&body[1..]);
+                o.mode = if e == 0.0 { Mode::Sum } else { Mode::Power(e) };
+            }
+            Some('p') if body == "p" => o.mode = Mode::Product,
+            Some('u') if body == "u" => o.mode = Mode::Max,
+            Some('l') if body == "l" => o.mode = Mode::Min,
+            Some('r') if body == "r" => o.running = true,
+            Some('t') => o.sep = body[1..].chars().next().or(Some('\t')),
+            Some('i') => {
+                let kind = match body[1..].chars().next() {
+                    Some('f') => Some(Binary::Float),
+                    Some('d') => Some(Binary::Double),
+                    Some('a') => None,
+                    _ => return Err(bad()),
+                };
+                let n = &body[2..];
+                let n = if n.is_empty() {
+                    1
+                } else {
+                    n.parse::<usize>().ok().filter(|&n| n > 0).ok_or_else(bad)?
+                };
+                o.input = kind.map(|k| (k, n));
+            }
+            Some('o') => {
+                o.output = match &body[1..] {
+                    "f" => Some(Binary::Float),
+                    "d" => Some(Binary::Double),
+                    "a" => None,
+                    _ => return Err(bad()),
+                }
+            }
+            Some(c) if c.is_ascii_digit() => {
+                o.count = body.parse::<usize>().map_err(|_| bad())?;
+            }
+            _ => return Err(bad()),
+        }
+    }
+    if o.mean && matches!(o.mode, Mode::Max | Mode::Min) {
+        bail!(
+            "average {}?! (-m cannot be combined with -u or -l)",
+            if o.mode == Mode::Max {
+                "maximum"
+            } else {
+                "minimum"
+            }
+        );
+    }
+    Ok((o, files))
+}
+
+/// C `atof`: the longest numeric prefix (decimal or hexadecimal, `inf`), 0 when there is
+/// none; `nan` counts as 0 (what Radiance's total makes of it in sums).
+fn atof(s: &str) -> f64 {
+    let b = s.trim_start().as_bytes();
+    let mut i = 0;
+    let neg = match b.first() {
+        Some(b'-') => {
+            i += 1;
+            true
+        }
+        Some(b'+') => {
+            i += 1;
+            false
+        }
+        _ => false,
+    };
+    let sign = if neg { -1.0 } else { 1.0 };
+    let rest = &b[i..];
+    let lower: Vec<u8> = rest
+        .iter()
+        .take(3)
+        .map(|c| c.to_ascii_lowercase())
+        .collect();
+    if lower == b"inf" {
+        return sign * f64::INFINITY;
+    }
+    if lower == b"nan" {
+        return 0.0;
+    }
+    if rest.len() > 2 && rest[0] == b'0' && (rest[1] | 0x20) == b'x' && rest[2].is_ascii_hexdigit()
+    {
+        let mut v = 0.0f64;
+        let mut j = 2;
+        while j < rest.len() && rest[j].is_ascii_hexdigit() {
+            v = v * 16.0 + (rest[j] as char).to_digit(16).unwrap_or(0) as f64;
+            j += 1;
+        }
+        if j < rest.len() && rest[j] == b'.' {
+            j += 1;
+            let mut scale = 1.0 / 16.0;
+            while j < rest.len() && rest[j].is_ascii_hexdigit() {
+                v += (rest[j] as char).to_digit(16).unwrap_or(0) as f64 * scale;
+                scale /= 16.0;
+                j += 1;
+            }
+        }
+        return sign * v;
+    }
+    let mut j = 0;
+    let digits = |j: &mut usize| {
+        let s = *j;
+        while *j < rest.len() && rest[*j].is_ascii_digit() {
+            *j += 1;
+        }
+        *j - s
+    };
+    let mut nd = digits(&mut j);
+    if j < rest.len() && rest[j] == b'.' {
+        j += 1;
+        nd += digits(&mut j);
+    }
+    if nd == 0 {
+        return 0.0;
+    }
+    let mant_end = j;
+    if j < rest.len() && (rest[j] | 0x20) == b'e' {
+        let mut k = j + 1;
+        if k < rest.len() && (rest[k] == b'+' || rest[k] == b'-') {
+            k += 1;
+        }
+        if digits(&mut k) > 0 {
+            j = k;
+        }
+    }
+    let text = std::str::from_utf8(&rest[..j]).unwrap_or("0");
+    let v = text
+        .parse::<f64>()
+        .or_else(|_| {
+            std::str::from_utf8(&rest[..mant_end])
+                .unwrap_or("0")
+                .parse()
+        })
+        .unwrap_or(0.0);
+    sign * v
+}
+
+/// Accumulators for one result.
+struct Acc {
+    mode: Mode,
+    vals: Vec<f64>,
+    rows: usize,
+    /// Columns of the records since the last result (the width printed).
+    width: usize,
+    /// Products that met an exact zero (printed as +0, as Radiance's total does).
+    zero: Vec<bool>,
+    /// Low parts of products kept in double-double (Radiance's total multiplies in
+    /// extended precision; this reproduces its rounding).
+    lo: Vec<f64>,
+}
+
+impl Acc {
+    fn new(mode: Mode) -> Acc {
+        Acc {
+            mode,
+            vals: Vec::new(),
+            rows: 0,
+            width: 0,
+            zero: Vec::new(),
+            lo: Vec::new(),
+        }
+    }
+
+    fn init(&self) -> f64 {
+        match self.mode {
+            Mode::Sum | Mode::Power(_) => 0.0,
+            Mode::Product => 1.0,
+            Mode::Max => -HUGE,
+            Mode::Min => HUGE,
+        }
+    }
+
+    fn reset(&mut self) {
+        self.vals.clear();
+        self.rows = 0;
+        self.width = 0;
+        self.zero.clear();
+        self.lo.clear();
+    }
+
+    /// After a result: start afresh, or (running) only the printed width.
+    fn next(&mut self, running: bool) {
+        if running {
+            self.width = 0;
+        } else {
+            self.reset();
+        }
+    }
+
+    fn add(&mut self, row: &[f64]) {
+        if row.len() > self.vals.len() {
+            let init = self.init();
+            self.vals.resize(row.len(), init);
+            self.zero.resize(row.len(), false);
+            self.lo.resize(row.len(), 0.0);
+        }
+        let cols = self.vals.iter_mut().zip(row).zip(&mut self.zero);
+        for (((a, &x), z), l) in cols.zip(&mut self.lo) {
+            match self.mode {
+                Mode::Sum => *a += x,
+                Mode::Power(e) => {
+                    if x != 0.0 {
+                        *a += x.abs().powf(e);
+                    }
+                }
+                Mode::Product => {
+                    let p = *a * x;
+                    if p.is_finite() && p != 0.0 {
+                        let e = a.mul_add(x, -p) + *l * x;
+                        let hi = p + e;
+                        *l = e - (hi - p);
+                        *a = hi;
+                    } else {
+                        *a = p;
+                        *l = 0.0;
+                    }
+                    *z |= x == 0.0;
+                }
+                Mode::Max => {
+                    if x > *a {
+                        *a = x
+                    }
+                }
+                Mode::Min => {
+                    if x < *a {
+                        *a = x
+                    }
+                }
+            }
+        }
+        self.rows += 1;
+        self.width = self.width.max(row.len());
+    }
+
+    fn result(&self, mean: bool, out: &mut Vec<f64>) {
+        out.clear();
+        // Radiance multiplies by the reciprocal of the count.
+        let inv = 1.0 / self.rows as f64;
+        for (&v, &z) in self.vals[..self.width].iter().zip(&self.zero) {
+            let v = if z { 0.0 } else { v };
+            out.push(if !mean {
+                v
+            } else {
+                match self.mode {
+                    Mode::Sum => v * inv,
+                    Mode::Power(e) => (v * inv).powf(1.0 / e),
+                    Mode::Product => {
+                        if v < 0.0 {
+                            -(-v).powf(inv)
+                        } else {
+                            v.powf(inv)
+                        }
+                    }
+                    Mode::Max | Mode::Min => v,
+                }
+            });
+        }
+    }
+}
+
+struct Printer<W: Write> {
+    w: W,
+    output: Option<Binary>,
+    sep: char,
+    text: String,
+    buf: Vec<f64>,
+}
+
+impl<W: Write> Printer<W> {
+    fn print(&mut self, acc: &Acc, mean: bool) -> Result<()> {
+        acc.result(mean, &mut self.buf);
+        match self.output {
+            None => {
+                self.text.clear();
+                for (i, &v) in self.buf.iter().enumerate() {
+                    if i > 0 {
+                        self.text.push(self.sep);
+                    }
+                    format_c_g(&mut self.text, v, 9);
+                }
+                self.text.push('\n');
+                self.w.write_all(self.text.as_bytes())?;
+            }
+            Some(Binary::Float) => {
+                for &v in &self.buf {
+                    self.w.write_all(&(v as f32).to_ne_bytes())?;
+                }
+            }
+            Some(Binary::Double) => {
+                for &v in &self.buf {
+                    self.w.write_all(&v.to_ne_bytes())?;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Totals one input.
+fn total_one<W: Write>(
+    r: &mut dyn BufRead,
+    name: &str,
+    o: &Opts,
+    p: &mut Printer<W>,
+) -> Result<()> {
+    let mut acc = Acc::new(o.mode);
+    let mut row: Vec<f64> = Vec::new();
+    match o.input {
+        Some((kind, n)) => {
+            let size = match kind {
+                Binary::Float => 4,
+                Binary::Double => 8,
+            };
+            let mut bytes = vec![0u8; size * n];
+            let mut pending = 0;
+            let mut rec = 0usize;
+            loop {
+                let got =
+                    read_full(r, &mut bytes).with_context(|| format!("{name}: read error"))?;
+                if got == 0 {
+                    break;
+                }
+                if got < bytes.len() {
+                    bail!(
+                        "{name}: {got} bytes at the end do not make a whole record of {n} {} (after {rec} records)",
+                        if kind == Binary::Float { "floats" } else { "doubles" }
+                    );
+                }
+                row.clear();
+                for c in bytes.chunks_exact(size) {
+                    row.push(if size == 4 {
+                        f32::from_ne_bytes([c[0], c[1], c[2], c[3]]) as f64
+                    } else {
+                        f64::from_ne_bytes(c.try_into().unwrap_or([0; 8]))
+                    });
+                }
+                rec += 1;
+                acc.add(&row);
+                pending += 1;
+                if o.count > 0 && pending == o.count {
+                    p.print(&acc, o.mean)?;
+                    pending = 0;
+                    acc.next(o.running);
+                }
+            }
+            if pending > 0 {
+                p.print(&acc, o.mean)?;
+            }
+        }
+        None => {
+            let mut line = Vec::new();
+            let mut lineno = 0usize;
+            'sets: loop {
+                let mut pending = 0;
+                let mut eof = false;
+                loop {
+                    line.clear();
+                    let n = r
+                        .read_until(b'\n', &mut line)
+                        .with_context(|| format!("{name}: read error after line {lineno}"))?;
+                    if n == 0 {
+                        eof = true;
+                        break;
+                    }
+                    lineno += 1;
+                    let text = String::from_utf8_lossy(&line);
+                    if text.trim().is_empty() {
+                        break;
+                    }
+                    row.clear();
+                    match o.sep {
+                        Some(c) if !c.is_whitespace() => {
+                            row.extend(text.trim_end_matches(['\n', '\r']).split(c).map(atof))
+                        }
+                        _ => row.extend(text.split_whitespace().map(atof)),
+                    }
+                    acc.add(&row);
+                    pending += 1;
+                    if o.count > 0 && pending == o.count {
+                        p.print(&acc, o.mean)?;
+                        pending = 0;
+                        acc.next(o.running);
+                    }
+                }
+                if pending == 0 {
+                    break 'sets;
+                }
+                p.print(&acc, o.mean)?;
+                acc.next(o.running);
+                if eof {
+                    break;
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+fn read_full(r: &mut dyn BufRead, buf: &mut [u8]) -> std::io::Result<usize> {
+    let mut n = 0;
+    while n < buf.len() {
+        match r.read(&mut buf[n..]) {
+            Ok(0) => break,
+            Ok(k) => n += k,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(n)
+}
+
 /// Runs total.
-pub fn run(_args: Vec<String>) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("not implemented yet")
+pub fn run(args: Vec<String>) -> Result<ExitCode> {
+    let (o, mut files) = parse(&args)?;
+    if files.is_empty() {
+        files.push("-".to_string());
+    }
+    let stdout = std::io::stdout();
+    let mut p = Printer {
+        w: std::io::BufWriter::with_capacity(1 << 16, stdout.lock()),
+        output: o.output,
+        sep: o.sep.unwrap_or('\t'),
+        text: String::new(),
+        buf: Vec::new(),
+    };
+    for f in &files {
+        let mut r = fenestra_cli::input::open(f)?;
+        let name = if f == "-" { "<stdin>" } else { f.as_str() };
+        total_one(&mut *r, name, &o, &mut p)?;
+    }
+    p.w.flush()?;
+    Ok(ExitCode::SUCCESS)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn atof_takes_the_numeric_prefix() {
+        for (s, v) in [
+            ("12abc", 12.0),
+            ("0x10", 16.0),
+            (".5e1", 5.0),
+            ("+3", 3.0),
+            ("-.5", -0.5),
+            ("1e", 1.0),
+            ("5e+", 5.0),
+            ("abc", 0.0),
+            ("", 0.0),
+            (" 7 ", 7.0),
+            ("nan", 0.0),
+        ] {
+            assert_eq!(atof(s), v, "{s}");
+        }
+        assert_eq!(atof("-inf"), f64::NEG_INFINITY);
+        assert_eq!(atof("INF"), f64::INFINITY);
+    }
 }
