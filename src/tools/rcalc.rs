@@ -190,7 +190,12 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                     let path = fenestra_cli::raypath::find_or_err(o.word())?;
                     prog.load_file(&path).map_err(anyhow::Error::new)?;
                 }
-                "n" => noinput = true,
+                "n" => {
+                    // as Radiance's rcalc: definitions after -n keep their literal
+                    // constants unfolded
+                    noinput = true;
+                    prog.set_parse_constants(false);
+                }
                 "u" => flush = true,
                 "w" => warn = false,
                 "l" | "b" | "s" => {}

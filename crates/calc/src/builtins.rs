@@ -139,6 +139,7 @@ impl Math1 {
             Math1::Tan => x.tan(),
             Math1::Asin if x.abs() > 1.0 => NEG_NAN,
             Math1::Acos if x.abs() > 1.0 => NEG_NAN,
+            Math1::Log10 if x < 0.0 => NEG_NAN,
             Math1::Asin => x.asin(),
             Math1::Acos => x.acos(),
             Math1::Atan => x.atan(),

@@ -87,7 +87,19 @@ impl Program {
             exprs,
             errors: c.errors,
         };
-        crate::fold::fold(&mut out);
+        let bad = crate::fold::fold(&mut out);
+        if let Some(&i) = bad.first() {
+            if !self.no_parse_constants {
+                let what = out
+                    .var_names
+                    .get(i)
+                    .map_or(String::new(), |n| format!("{n}: "));
+                return Err(CalcError::new(
+                    ErrorKind::Syntax,
+                    format!("{what}bad constant expression"),
+                ));
+            }
+        }
         Ok(out)
     }
 }
@@ -135,23 +147,7 @@ impl Compiler<'_> {
                 Node::Neg(Box::new(a))
             }
             Expr::Bin(op, a, b) => {
-                // Radiance's parser turns `x - c` into `x + (-c)` and `x / c` into
-                // `x * (1/c)` when `c` is made of literals only (named constants do
-                // not count); the rounding and the sign of zero follow from that.
-                let lit = match op {
-                    BinOp::Sub | BinOp::Div if literal_value(a, self.prog.extras).is_none() => {
-                        literal_value(b, self.prog.extras)
-                    }
-                    _ => None,
-                };
                 let a = self.expr(a, params);
-                match (op, lit) {
-                    (BinOp::Sub, Some(c)) => return Node::Add(Box::new((a, Node::Num(-c)))),
-                    (BinOp::Div, Some(c)) if c != 0.0 => {
-                        return Node::Mul(Box::new((a, Node::Num(1.0 / c))))
-                    }
-                    _ => {}
-                }
                 let b = self.expr(b, params);
                 let pair = Box::new((a, b));
                 match op {
@@ -210,37 +206,5 @@ impl Compiler<'_> {
                 }
             }
         }
-    }
-}
-
-/// The value of an expression made only of numeric literals, operators and the
-/// one- and two-argument math built-ins (what Radiance's parser folds), if it is one.
-fn literal_value(e: &Expr, extras: builtins::Extras) -> Option<f64> {
-    match e {
-        Expr::Num(v) => Some(*v),
-        Expr::Neg(a) => literal_value(a, extras).map(|v| -v),
-        Expr::Bin(op, a, b) => {
-            let x = literal_value(a, extras)?;
-            let y = literal_value(b, extras)?;
-            Some(match op {
-                BinOp::Add => x + y + 0.0,
-                BinOp::Sub => x - y,
-                BinOp::Mul => x * y,
-                BinOp::Div if y == 0.0 => return None,
-                BinOp::Div => x / y,
-                BinOp::Pow => x.powf(y),
-            })
-        }
-        Expr::Call(name, args, _) => match builtins::lookup(name, extras)? {
-            (Builtin::Math1(m), _) if args.len() == 1 => {
-                Some(m.apply(literal_value(&args[0], extras)?))
-            }
-            (Builtin::Atan2, _) if args.len() == 2 => {
-                let y = literal_value(&args[0], extras)?;
-                Some(y.atan2(literal_value(&args[1], extras)?))
-            }
-            _ => None,
-        },
-        Expr::Name(..) | Expr::Chan(..) => None,
     }
 }

@@ -482,15 +482,24 @@ impl Compiled {
             }
             Builtin::Math1(m) => m.apply(self.eval(&args[0], st, fr)),
             Builtin::Atan2 => {
-                let y = self.eval(&args[0], st, fr);
-                y.atan2(self.eval(&args[1], st, fr))
+                // Radiance's build evaluates the second argument first
+                let x = self.eval(&args[1], st, fr);
+                self.eval(&args[0], st, fr).atan2(x)
             }
             Builtin::Select => {
                 let n = self.eval(&args[0], st, fr);
                 let count = args.len() - 1;
-                if n < -0.5 {
+                if n.is_nan() || n < -0.5 {
                     st.errno = ErrFlag::Domain;
                     return 0.0;
+                }
+                if n + 0.5 >= 2147483648.0 {
+                    // Radiance converts the index to a C int and fails outright
+                    return self.dyn_fail(
+                        st,
+                        ErrorKind::Other,
+                        "select(): bad call to argument (index beyond the integer range)".into(),
+                    );
                 }
                 let i = (n + 0.5) as i64;
                 if i == 0 {
@@ -503,8 +512,10 @@ impl Compiled {
                 self.eval(&args[i as usize], st, fr)
             }
             Builtin::Max | Builtin::Min => {
+                // Radiance's build evaluates the first argument, then the others
+                // from the last backwards (observable through the error flag)
                 let mut m = self.eval(&args[0], st, fr);
-                for a in &args[1..] {
+                for a in args[1..].iter().rev() {
                     let v = self.eval(a, st, fr);
                     if (b == Builtin::Max && v > m) || (b == Builtin::Min && v < m) {
                         m = v;
@@ -514,12 +525,12 @@ impl Compiled {
             }
             Builtin::Rand => builtins::rand_hash(self.eval(&args[0], st, fr)),
             Builtin::Jn => {
-                let n = self.eval(&args[0], st, fr);
-                builtins::jn(n, self.eval(&args[1], st, fr))
+                let x = self.eval(&args[1], st, fr);
+                builtins::jn(self.eval(&args[0], st, fr), x)
             }
             Builtin::Yn => {
-                let n = self.eval(&args[0], st, fr);
-                builtins::yn(n, self.eval(&args[1], st, fr))
+                let x = self.eval(&args[1], st, fr);
+                builtins::yn(self.eval(&args[0], st, fr), x)
             }
             Builtin::In => {
                 let n = self.eval(&args[0], st, fr);
@@ -590,8 +601,9 @@ impl Compiled {
             }),
             Node::Math1(m, a) => self.lib_call(st, m.name(), |c, st| m.apply(c.eval(a, st, fr))),
             Node::Atan2(p) => self.lib_call(st, "atan2", |c, st| {
-                let y = c.eval(&p.0, st, fr);
-                y.atan2(c.eval(&p.1, st, fr))
+                // Radiance's build evaluates the second argument first
+                let x = c.eval(&p.1, st, fr);
+                c.eval(&p.0, st, fr).atan2(x)
             }),
             Node::Builtin(b, args) => self.call_builtin(*b, args, st, fr),
             Node::CallUser(f, args) => self.call_user(*f, args, st, fr),

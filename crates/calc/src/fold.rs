@@ -18,6 +18,8 @@ enum Mark {
 struct Purity {
     vars: Vec<Mark>,
     funcs: Vec<Mark>,
+    /// Constant sub-expressions whose evaluation raised an error.
+    bad: usize,
 }
 
 impl Purity {
@@ -151,6 +153,7 @@ fn fold_node(c: &Compiled, p: &mut Purity, n: &mut Node, in_func: bool) {
                 *n = Node::Num(count as f64);
             } else if i <= count {
                 *n = args[i].clone();
+                return;
             }
         }
         return;
@@ -181,11 +184,14 @@ fn contains_param(n: &Node) -> bool {
     }
 }
 
-/// Folds constants in place.
-pub(crate) fn fold(c: &mut Compiled) {
+/// Folds constants in place; returns the `:` constants whose value raised an error
+/// (Radiance refuses them: "bad constant expression").
+pub(crate) fn fold(c: &mut Compiled) -> Vec<usize> {
+    let mut bad = Vec::new();
     let mut p = Purity {
         vars: vec![Mark::Unknown; c.vars.len()],
         funcs: vec![Mark::Unknown; c.funcs.len()],
+        bad: 0,
     };
     // 1. pure variables become constants
     for i in 0..c.vars.len() {
@@ -195,6 +201,11 @@ pub(crate) fn fold(c: &mut Compiled) {
         let node = Node::Var(i as u32);
         if let Some(v) = try_eval(c, &node) {
             c.vars[i] = VarSlot::Const(v);
+        } else if matches!(c.vars[i], VarSlot::Def(_, true)) {
+            let mut st = c.state();
+            if crate::eval::probe(c, &node, &mut st).is_some() && st.take_warnings().any() {
+                bad.push(i);
+            }
         }
     }
     // 2. fold inside every body (working on copies, as evaluation reads the program)
@@ -220,4 +231,8 @@ pub(crate) fn fold(c: &mut Compiled) {
         fold_node(c, &mut p, &mut node, false);
         c.exprs[k] = node;
     }
+    if p.bad > 0 && bad.is_empty() {
+        bad.push(usize::MAX);
+    }
+    bad
 }

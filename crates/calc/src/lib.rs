@@ -21,6 +21,7 @@ pub mod error;
 mod eval;
 mod fold;
 pub mod format;
+mod lit;
 mod node;
 pub mod parse;
 mod program;

@@ -62,6 +62,8 @@ pub struct Program {
     pub(crate) hosts: Vec<HostFunc>,
     pub(crate) exprs: Vec<Expr>,
     pub(crate) extras: Extras,
+    /// Radiance's parse-time constant handling is off (see [`Program::set_parse_constants`]).
+    pub(crate) no_parse_constants: bool,
 }
 
 impl Program {
@@ -84,6 +86,14 @@ impl Program {
         let mut p = Program::new();
         p.extras.render = true;
         p
+    }
+
+    /// Turns Radiance's parse-time constant handling on (the default) or off for the
+    /// definitions loaded afterwards (rcalc's `-n` turns it off): literal
+    /// sub-expressions folded, `x - c` read as `x + (-c)`, `x / c` as `x * (1/c)`,
+    /// and a literal expression that divides by zero refused.
+    pub fn set_parse_constants(&mut self, on: bool) {
+        self.no_parse_constants = !on;
     }
 
     /// Enables or disables optional built-in groups.
@@ -126,7 +136,20 @@ impl Program {
                 Self::location(&self.sources, e.pos),
             )
         })?;
-        for d in defs {
+        for mut d in defs {
+            if !self.no_parse_constants {
+                if let Err(r) = crate::lit::fold(&mut d.body, self.extras, &self.defs) {
+                    let msg = match r {
+                        crate::lit::Refused::BadConstant => "bad constant expression",
+                        crate::lit::Refused::DivideByZero => "divide by zero constant",
+                    };
+                    return Err(CalcError::at(
+                        ErrorKind::Syntax,
+                        msg.to_string(),
+                        Self::location(&self.sources, d.pos),
+                    ));
+                }
+            }
             self.define(d);
         }
         Ok(())
