@@ -4,5 +4,6 @@
 
 pub mod calc;
 pub mod engine;
+pub mod klemsamp;
 pub mod native;
 pub mod output;
