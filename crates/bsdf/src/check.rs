@@ -164,6 +164,95 @@ pub fn energy_balance(b: &Bsdf, exterior: bool) -> Option<(f64, usize)> {
     )
 }
 
+/// Summarises the `Visible` tensor tree of `d` (`None` when absent or not a tree): the
+/// Lambertian part is π × the smallest value (when above [`LAMBERTIAN_MIN`]); totals integrate
+/// the tree exactly on its finest grid (the square ↔ disk map preserves projected solid
+/// angle: a cell of area `a` covers `π·a`); the angle is `2 × the finest cell size` radians.
+pub fn tree_component(b: &Bsdf, d: Direction) -> Option<ComponentCheck> {
+    let blk = b.block(d, &Wavelength::Visible)?;
+    let t = match &blk.data {
+        crate::model::BlockData::Tree(t) => t,
+        crate::model::BlockData::Klems(_) => return None,
+    };
+    let cell = t.finest_cell();
+    let n = (1.0 / cell).round().max(1.0) as usize;
+    let c = |k: usize| (k as f64 + 0.5) / n as f64;
+    // Smallest value over the part of the tree that directions reach (rank 3 uses only the
+    // lower half of its incident dimension).
+    let min = if t.rank() == 3 {
+        let mut m = f64::INFINITY;
+        for j in 0..n.div_ceil(2) {
+            for a in 0..n {
+                for bb in 0..n {
+                    m = m.min(t.lookup(&[c(j), c(a), c(bb)]));
+                }
+            }
+        }
+        m
+    } else {
+        t.min_value()
+    };
+    let y = if min > LAMBERTIAN_MIN {
+        std::f64::consts::PI * min
+    } else {
+        0.0
+    };
+    let hemi = |inc: &[f64]| -> f64 {
+        let mut sum = 0.0;
+        let mut pos = inc.to_vec();
+        pos.extend_from_slice(&[0.0, 0.0]);
+        let r = inc.len();
+        for a in 0..n {
+            for bb in 0..n {
+                pos[r] = c(a);
+                pos[r + 1] = c(bb);
+                sum += t.lookup(&pos);
+            }
+        }
+        std::f64::consts::PI * sum / (n * n) as f64
+    };
+    let mut totals = Vec::new();
+    if t.rank() == 3 {
+        // Incident position 0.5 − r/2 covers [0, 0.5): r = 1 (grazing) … 0 (normal).
+        for j in 0..n.div_ceil(2) {
+            totals.push(hemi(&[c(j)]));
+        }
+    } else {
+        for i in 0..n {
+            for j in 0..n {
+                totals.push(hemi(&[c(i), c(j)]));
+            }
+        }
+    }
+    let max_total = totals.iter().copied().fold(0.0, f64::max);
+    let normal_total = if t.rank() == 3 {
+        totals.last().copied().unwrap_or(0.0)
+    } else {
+        hemi(&[0.5, 0.5])
+    };
+    // Diffuse incidence: incident cells weighted by their projected solid angle (uniform in
+    // the square for rank 4; for rank 3 the cell j covers radii r in [1 − 2(j+1)/n, 1 − 2j/n]).
+    let diffuse_total = if t.rank() == 3 {
+        let mut acc = 0.0;
+        for (j, tot) in totals.iter().enumerate() {
+            let r_hi = (1.0 - 2.0 * j as f64 / n as f64).clamp(0.0, 1.0);
+            let r_lo = (1.0 - 2.0 * (j + 1) as f64 / n as f64).clamp(0.0, 1.0);
+            acc += tot * (r_hi * r_hi - r_lo * r_lo);
+        }
+        acc
+    } else {
+        totals.iter().sum::<f64>() / totals.len().max(1) as f64
+    };
+    Some(ComponentCheck {
+        lambertian_xyz: [y; 3],
+        max_total,
+        min_angle_deg: (2.0 * cell).to_degrees(),
+        normal_total,
+        diffuse_total,
+        totals,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
