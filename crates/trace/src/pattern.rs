@@ -37,9 +37,27 @@ const HOST_VARS: [&str; 28] = [
     "RdotP", "S", "Ix", "Iy", "Iz", "Jx", "Jy", "Jz", "Kx", "Ky", "Kz", "Tx", "Ty",
 ];
 
+/// Evaluation states kept for reuse, so a pattern evaluation allocates nothing once
+/// each thread has made its first one.
+#[derive(Default)]
+struct StatePool(std::sync::Mutex<Vec<fenestra_calc::State>>);
+
+impl StatePool {
+    fn with<R>(&self, exe: &Compiled, f: impl FnOnce(&mut fenestra_calc::State) -> R) -> R {
+        let taken = self.0.lock().map(|mut v| v.pop()).unwrap_or(None);
+        let mut st = taken.unwrap_or_else(|| exe.state());
+        let r = f(&mut st);
+        if let Ok(mut v) = self.0.lock() {
+            v.push(st);
+        }
+        r
+    }
+}
+
 /// A pattern compiled from a .cal file.
 pub struct CalPattern {
     exe: Compiled,
+    pool: StatePool,
     vars: Vec<VarId>,
     exprs: Vec<ExprId>,
     fargs: Vec<f64>,
@@ -83,6 +101,7 @@ impl CalPattern {
         let exe = p.compile().map_err(|e| anyhow!("{e}"))?;
         let cp = CalPattern {
             exe,
+            pool: StatePool::default(),
             vars,
             exprs: ids,
             fargs: fargs.to_vec(),
@@ -112,20 +131,18 @@ impl CalPattern {
     }
 
     fn eval(&self, q: &PatternInput) -> Result<DVec3> {
-        let mut st = self.exe.state();
-        st.set_all(&self.vars, &Self::values(q));
-        st.set_fargs(&self.fargs);
-        let mut out = [0.0; 3];
-        for (k, e) in self.exprs.iter().enumerate() {
-            out[k] = self
-                .exe
-                .eval_expr(&mut st, *e)
-                .map_err(|e| anyhow!("{e}"))?;
-        }
-        if self.exprs.len() == 1 {
-            out = [out[0]; 3];
-        }
-        Ok(DVec3::from_array(out))
+        self.pool.with(&self.exe, |st| {
+            st.set_all(&self.vars, &Self::values(q));
+            st.set_fargs(&self.fargs);
+            let mut out = [0.0; 3];
+            for (k, e) in self.exprs.iter().enumerate() {
+                out[k] = self.exe.eval_expr(st, *e).map_err(|e| anyhow!("{e}"))?;
+            }
+            if self.exprs.len() == 1 {
+                out = [out[0]; 3];
+            }
+            Ok(DVec3::from_array(out))
+        })
     }
 }
 
@@ -147,6 +164,7 @@ pub enum Pattern {
 /// values (brightdata: `func(v)`; colordata: `rfunc(r,g,b)`, `gfunc(…)`, `bfunc(…)`).
 pub struct DataPattern {
     exe: Compiled,
+    pool: StatePool,
     vars: Vec<VarId>,
     coords: Vec<ExprId>,
     funcs: Vec<FuncId>,
@@ -165,26 +183,28 @@ impl std::fmt::Debug for DataPattern {
 
 impl DataPattern {
     fn eval(&self, q: &PatternInput) -> Result<DVec3> {
-        let mut st = self.exe.state();
-        st.set_all(&self.vars, &CalPattern::values(q));
-        st.set_fargs(&self.fargs);
-        let mut x = [0.0f64; 16];
-        for (k, e) in self.coords.iter().enumerate() {
-            x[k] = self
-                .exe
-                .eval_expr(&mut st, *e)
-                .map_err(|e| anyhow!("{e}"))?;
-        }
-        let x = &x[..self.coords.len()];
-        let v: Vec<f64> = self.grids.iter().map(|g| g.value(x)).collect();
-        let mut out = [0.0; 3];
-        for (k, f) in self.funcs.iter().enumerate() {
-            out[k] = self.exe.call(&mut st, *f, &v).map_err(|e| anyhow!("{e}"))?;
-        }
-        if self.funcs.len() == 1 {
-            out = [out[0]; 3];
-        }
-        Ok(DVec3::from_array(out))
+        self.pool.with(&self.exe, |st| {
+            st.set_all(&self.vars, &CalPattern::values(q));
+            st.set_fargs(&self.fargs);
+            let mut x = [0.0f64; 16];
+            for (k, e) in self.coords.iter().enumerate() {
+                x[k] = self.exe.eval_expr(st, *e).map_err(|e| anyhow!("{e}"))?;
+            }
+            let x = &x[..self.coords.len()];
+            let mut v = [0.0f64; 3];
+            for (k, g) in self.grids.iter().enumerate() {
+                v[k] = g.value(x);
+            }
+            let v = &v[..self.grids.len()];
+            let mut out = [0.0; 3];
+            for (k, f) in self.funcs.iter().enumerate() {
+                out[k] = self.exe.call(st, *f, v).map_err(|e| anyhow!("{e}"))?;
+            }
+            if self.funcs.len() == 1 {
+                out = [out[0]; 3];
+            }
+            Ok(DVec3::from_array(out))
+        })
     }
 }
 
@@ -297,6 +317,7 @@ fn compile_data(q: &fenestra_scene::Primitive, what: &str, user: &[CalSource]) -
     }
     let dp = DataPattern {
         exe,
+        pool: StatePool::default(),
         vars,
         coords: ids,
         funcs,

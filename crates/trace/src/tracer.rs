@@ -820,13 +820,15 @@ impl Tracer {
         {
             return (DVec3::ZERO, true);
         }
-        if let Some(s) = r.src {
-            if self.sources[s].mat != m {
-                return (DVec3::ZERO, true);
-            }
+        let own_source = r.src.is_none_or(|s| self.sources[s].mat == m);
+        if !own_source && !matches!(kind, LightKind::Illum(_)) {
+            return (DVec3::ZERO, true);
         }
         if let LightKind::Illum(alt) = kind {
-            if r.src.is_none() {
+            // An illum is a source only for its own shadow rays; any other ray (a view
+            // ray, or a shadow ray toward another source such as the sun through the
+            // window it stands in) meets its alternate material.
+            if r.src.is_none() || !own_source {
                 if let Some(shape) = shape {
                     return match alt {
                         Some(a) => {
