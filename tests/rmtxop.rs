@@ -188,6 +188,7 @@ fn oracle_operations_are_byte_identical() {
         "-fa -c 47.435 119.93 11.635 -t res_t1_mar21_1000_clear.dat",
         "-fa T.mtx * T.mtx",
         "-fa sawtooth.xml",
+        "-fa -rb sawtooth.xml",
         "-fc T.mtx",
         "-fa img_t1_mar21_1000_clear.hdr",
         "-fa m23h.txt m32h.txt",
@@ -224,16 +225,21 @@ fn oracle_operations_are_byte_identical() {
 /// From a coloured XML BSDF, Radiance stores each element's chromaticity quantised with a
 /// random dither (see tests/bsdf_xml.rs), so only the luminance is reproducible: the
 /// `-c .265 .670 .065` (Y) matrix agrees within 2e-5 relative (float storage and the
-/// 4-digit primaries' round-off), also through a product with D.
+/// 4-digit primaries' round-off), also through a product with D; so do the reflection
+/// matrices (`-rf`, `-rb`; grey sawtooth.xml within 2e-7: single-precision rounding of the
+/// diffuse split).
 #[test]
 fn oracle_xml_luminance_agrees() {
     let Some(o) = common::oracle() else { return };
     let dir = common::scratch("rmtxop-xml");
-    for f in ["blinds_kf.xml", "D_rflux.dmx"] {
+    for f in ["blinds_kf.xml", "D_rflux.dmx", "sawtooth.xml"] {
         std::fs::copy(tp().join(f), dir.join(f)).unwrap();
     }
     for case in [
+        "-fd -c .265 .670 .065 -rf blinds_kf.xml",
+        "-fd -c .265 .670 .065 -rb blinds_kf.xml",
         "-fd -c .265 .670 .065 blinds_kf.xml",
+        "-fd -c .265 .670 .065 -rf sawtooth.xml",
         "-fd -c .265 .670 .065 blinds_kf.xml -c .265 .670 .065 D_rflux.dmx",
     ] {
         let a = words(case);
@@ -295,7 +301,7 @@ fn bad_input_fails_cleanly() {
         ("m23h.txt +", "after the last matrix"),
         ("-fx m23h.txt", "unknown output format"),
         ("-fc -c 1 1 1 1 1 1 m23h.txt", "RGBE"),
-        ("-rf blinds.xml", "not supported"),
+        ("-rf missing.xml", "missing.xml"),
         ("m23h.txt / m23h.txt", "not supported"),
     ] {
         let out = run(

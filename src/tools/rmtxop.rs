@@ -10,17 +10,19 @@ use fenestra_dc::ops::{multiply_chain, Mtx, XmlPart};
 use fenestra_formats::header::Header;
 use fenestra_formats::matrix::{AsciiLayout, DataFormat, MatrixWriter, WriteOptions};
 
-const USAGE: &str = "Usage: rmtxop [-v][-f{adfc}][-t][-s sf .. | -c ce ..] m1 [.+*] .. > mres";
+const USAGE: &str =
+    "Usage: rmtxop [-v][-f{adfc}][-t][-s sf .. | -c ce ..][-rf|-rb] m1 [.+*] .. > mres";
 
 const HELP: &str = "rmtxop: matrix operations on Radiance matrices, BSDF XML files and pictures
 
-Usage: rmtxop [-v][-f{adfc}][-t][-s sf ..][-c ce ..] m1 [.+*] m2 .. > mres
+Usage: rmtxop [-v][-f{adfc}][-t][-s sf ..][-c ce ..][-rf|-rb] m1 [.+*] m2 .. > mres
 
 Options before a matrix apply to that matrix only:
   -t           transpose it
   -s sf ..     scale it: one factor, or one per (output) component
   -c ce ..     component transform: N x NCOMP coefficients give N components
                (-c 47.435 119.93 11.635 turns RGB irradiance into illuminance)
+  -rf, -rb     for an XML BSDF: front or back reflection instead of transmission
 Global options:
   -fa -ff -fd -fc   output as ascii, float, double or RGBE (default: the first input's format)
   -v           report each operation on stderr
@@ -64,7 +66,7 @@ fn parse(args: &[String]) -> Result<Parsed> {
     let mut transpose = false;
     let mut scale: Option<Vec<f64>> = None;
     let mut cmat: Option<Vec<f64>> = None;
-    let part = XmlPart::Transmission;
+    let mut part = XmlPart::Transmission;
     let mut op: Option<Op> = None;
     let mut i = 1;
     // Numbers following -s/-c.
@@ -107,9 +109,8 @@ fn parse(args: &[String]) -> Result<Parsed> {
             "-t" => transpose = !transpose,
             "-s" => scale = Some(numbers(&mut i, a)?),
             "-c" => cmat = Some(numbers(&mut i, a)?),
-            "-rf" | "-rb" => bail!(
-                "option '{a}' (BSDF reflection matrices) is not supported by fenestra's rmtxop yet"
-            ),
+            "-rf" => part = XmlPart::ReflectionFront,
+            "-rb" => part = XmlPart::ReflectionBack,
             _ if a.starts_with("-f") && a.len() > 2 => {
                 format = Some(match &a[2..] {
                     "a" => DataFormat::Ascii,
@@ -139,6 +140,7 @@ fn parse(args: &[String]) -> Result<Parsed> {
                     part,
                 });
                 transpose = false;
+                part = XmlPart::Transmission;
                 op = None;
             }
         }

@@ -117,14 +117,16 @@ impl Mtx {
                 .map_err(|e| anyhow::anyhow!("{name}: {e}"))?,
             XmlPart::ReflectionFront | XmlPart::ReflectionBack => {
                 let front = part == XmlPart::ReflectionFront;
-                fenestra_bsdf::radiance::reflection_matrix(&b, front)
+                match fenestra_bsdf::radiance::reflection_matrix(&b, front)
                     .map_err(|e| anyhow::anyhow!("{name}: {e}"))?
-                    .with_context(|| {
-                        format!(
-                            "{name}: no {} reflection data in BSDF",
-                            if front { "front" } else { "back" }
-                        )
-                    })?
+                {
+                    Some(m) => m,
+                    // No such block: a zero matrix in the full Klems basis, as Radiance.
+                    None => {
+                        let n = fenestra_bsdf::KlemsBasis::full().len();
+                        fenestra_bsdf::radiance::RgbMatrix::zeros(n, n)
+                    }
+                }
             }
         };
         let mut data = Vec::with_capacity(m.data.len() * 3);
