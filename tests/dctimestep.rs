@@ -329,7 +329,7 @@ fn oracle_headers_and_values_match() {
 #[test]
 fn oracle_rgbe_and_picture_form_identical() {
     let Some(o) = common::oracle() else { return };
-    let cases: [&[&str]; 4] = [
+    let cases: [&[&str]; 5] = [
         &[
             "-oc",
             "V.vmx",
@@ -348,6 +348,15 @@ fn oracle_rgbe_and_picture_form_identical() {
         ],
         &["-oc", "V.vmx", "T.mtx", "D.dmx", "test.m1.smx"],
         &[
+            "vimg/v%03d.hdr",
+            "T.mtx",
+            "D.dmx",
+            "sky_t3_dec21_1200_clear.skv",
+        ],
+        // -x/-y are ignored by the picture form, as by Radiance.
+        &[
+            "-x",
+            "16",
             "vimg/v%03d.hdr",
             "T.mtx",
             "D.dmx",

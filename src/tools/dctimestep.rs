@@ -841,7 +841,8 @@ fn picture_form(vspec: &str, td: Option<Planar>, sky: &PackedSky, o: &Opts) -> R
             sum = vec![[0.0; 3]; res.scanlen() * res.numscans()];
         }
         let (w, h) = (res.scanlen(), res.numscans());
-        let (oh, ow) = reshape(h, w, o)?;
+        // -x/-y do not apply to the picture form (Radiance ignores them there too).
+        let (oh, ow) = (h, w);
         let frame = (steps > 1).then_some(t);
         let mut hb = if per_step.is_none() && t > 0 && o.header {
             // Later frames in one stream: Radiance writes only FRAME, FORMAT and the resolution.
