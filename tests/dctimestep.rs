@@ -627,3 +627,97 @@ fn mf2_sky_rejected_and_sun_only_sky() {
     let w = worst_rel(&ascii(&ra.1), &ascii(&rb.1));
     assert!(w < PRINT_TOL, "sun only: {w}");
 }
+
+fn synthetic_xml(
+    dir: &Path,
+    name: &str,
+    incident: &fenestra_bsdf::KlemsBasis,
+    outgoing: &fenestra_bsdf::KlemsBasis,
+    f: impl Fn(usize, usize) -> f64,
+) -> PathBuf {
+    use fenestra_bsdf::{Block, BlockData, Bsdf, Direction, KlemsMatrix, Wavelength};
+    let values = (0..outgoing.len())
+        .flat_map(|o| (0..incident.len()).map(move |i| (o, i)))
+        .map(|(o, i)| f(o, i))
+        .collect();
+    let b = Bsdf {
+        name: "synthetic".into(),
+        blocks: vec![Block {
+            wavelength: Wavelength::Visible,
+            direction: Direction::TransmissionFront,
+            data_type: "BTDF".into(),
+            data: BlockData::Klems(KlemsMatrix {
+                incident: incident.clone(),
+                outgoing: outgoing.clone(),
+                values,
+            }),
+        }],
+        ..Default::default()
+    };
+    let p = dir.join(name);
+    std::fs::write(&p, fenestra_bsdf::write::klems_xml(&b, None).unwrap()).unwrap();
+    p
+}
+
+/// Grey synthetic XML T against the oracle (no colour quantisation): a specular glazing
+/// (diagonal peak 1e4 sr⁻¹) and mixed bases (incident Klems full, outgoing half: T is 77×145,
+/// so V needs 77 columns; a 145-column V is an error naming both).
+#[test]
+fn oracle_specular_and_mixed_basis_xml() {
+    let dir = common::scratch("dctimestep-xml");
+    let (full, half) = (
+        fenestra_bsdf::KlemsBasis::full(),
+        fenestra_bsdf::KlemsBasis::half(),
+    );
+    let spec = synthetic_xml(
+        &dir,
+        "spec.xml",
+        full,
+        full,
+        |o, i| {
+            if o == i {
+                1e4
+            } else {
+                0.0
+            }
+        },
+    );
+    let mixed = synthetic_xml(&dir, "mixed.xml", full, half, |o, i| {
+        ((o * 7 + i * 3) % 11) as f64 * 0.01
+    });
+    let v77 = write(
+        &dir,
+        "v77.mtx",
+        &mtx(6, 77, |r, c| ((r + c) % 5) as f64 * 1e-3),
+    );
+    let d = tp("D.dmx");
+    let sky = tp("sky_t2_jun21_1500_clear.skv");
+    // Wrong V for the mixed T.
+    let out = common::fenestra("dctimestep")
+        .arg(tp("V.vmx"))
+        .arg(&mixed)
+        .arg(&d)
+        .arg(&sky)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("V.vmx")
+            && err.contains("145 columns")
+            && err.contains("mixed.xml")
+            && err.contains("77 rows"),
+        "{err}"
+    );
+    let Some(o) = common::oracle() else { return };
+    for (v, t) in [(tp("V.vmx"), &spec), (v77.clone(), &mixed)] {
+        let mut a = common::fenestra("dctimestep");
+        a.arg(&v).arg(t).arg(&d).arg(&sky);
+        let mut b = o.command("dctimestep");
+        b.arg(&v).arg(t).arg(&d).arg(&sky);
+        let (ra, rb) = (split(&run(a)), split(&run(b)));
+        assert_eq!(ra.0, rb.0, "{t:?}: header");
+        let w = worst_rel(&ascii(&ra.1), &ascii(&rb.1));
+        assert!(w < PRINT_TOL, "{t:?}: worst relative difference {w}");
+    }
+}
