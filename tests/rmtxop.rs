@@ -319,3 +319,89 @@ fn bad_input_fails_cleanly() {
         assert!(!err.contains("panicked"), "{err}");
     }
 }
+
+/// Mutated inputs (bytes flipped, truncated, duplicated, header keys changed) never make
+/// rmtxop panic: it either succeeds or fails with a message and no output.
+#[test]
+fn mutated_inputs_never_panic() {
+    let dir = common::scratch("rmtxop-fuzz");
+    let sources = [
+        std::fs::read(common::fixture("matrices/m23h.txt")).unwrap(),
+        std::fs::read(tp().join("res_t1_mar21_1000_clear.dat")).unwrap(),
+        {
+            let out = run(
+                common::fenestra("rmtxop"),
+                &tp(),
+                &words("-ff res_t1_mar21_1000_clear.dat"),
+            );
+            out.stdout
+        },
+        {
+            let out = run(
+                common::fenestra("rmtxop"),
+                &tp(),
+                &words("-fd -t res_t1_mar21_1000_clear.dat"),
+            );
+            out.stdout
+        },
+    ];
+    let mut seed = 0x9e3779b97f4a7c15u64;
+    let mut rnd = |n: usize| {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed % n.max(1) as u64) as usize
+    };
+    let swaps = [
+        ("NROWS=", "NROWS=9"),
+        ("NCOLS=", "NCOLS=0"),
+        ("NCOMP=", "NCOMP=7"),
+        ("FORMAT=ascii", "FORMAT=float"),
+        ("FORMAT=float", "FORMAT=double"),
+        ("BigEndian=0", "BigEndian=1"),
+        ("\n\n", "\n"),
+    ];
+    let mut runs = 0;
+    for src in &sources {
+        for k in 0..24 {
+            let mut d = src.clone();
+            match k % 4 {
+                0 => {
+                    for _ in 0..1 + rnd(8) {
+                        let i = rnd(d.len());
+                        d[i] ^= 1 << rnd(8);
+                    }
+                }
+                1 => d.truncate(rnd(d.len())),
+                2 => {
+                    let i = rnd(d.len());
+                    let tail = d[i..].to_vec();
+                    d.extend_from_slice(&tail);
+                }
+                _ => {
+                    let (a, b) = swaps[rnd(swaps.len())];
+                    // Replace in the header only (binary data stay as they are).
+                    if let Some(p) = d.windows(2).position(|w| w == b"\n\n") {
+                        let head = String::from_utf8_lossy(&d[..p + 2]).replacen(a, b, 1);
+                        let mut nd = head.into_bytes();
+                        nd.extend_from_slice(&d[p + 2..]);
+                        d = nd;
+                    }
+                }
+            }
+            std::fs::write(dir.join("m.in"), &d).unwrap();
+            for args in ["-fa m.in", "-ff -t m.in", "-fa -c 1 1 1 m.in"] {
+                let out = run(common::fenestra("rmtxop"), &dir, &words(args));
+                let err = String::from_utf8_lossy(&out.stderr);
+                assert!(!err.contains("panicked"), "rmtxop {args} panicked: {err}");
+                assert!(matches!(out.status.code(), Some(0) | Some(1)), "{err}");
+                if !out.status.success() {
+                    assert!(out.stdout.is_empty(), "rmtxop {args} failed after writing");
+                    assert!(err.contains("fatal"), "{err}");
+                }
+                runs += 1;
+            }
+        }
+    }
+    eprintln!("{runs} mutated runs without a panic");
+}

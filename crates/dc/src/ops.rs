@@ -78,7 +78,7 @@ impl Mtx {
         let row_len = info.row_len();
         let mut data: Vec<f32> = Vec::new();
         if let Some(n) = info.nrows {
-            data.reserve(n.saturating_mul(row_len).min(1 << 24));
+            data.reserve(n.saturating_mul(row_len).min(1 << 20));
         }
         let mut row = vec![0.0f64; row_len];
         let mut nrows = 0;
