@@ -355,3 +355,69 @@ fn oracle_d_matrix_from_our_rays() {
     eprintln!("D row sums: worst |z| {worst:.2}; totals ours {ta:.3}, reference {tb:.3}");
     assert!((ta / tb - 1.0).abs() < 0.01, "totals {ta} {tb}");
 }
+
+/// The documented fenestra-only pipeline: `oconv`, `genklemsamp | rtcontrib`, on the
+/// reference office; D agrees with the reference D as in the oracle test above.
+#[test]
+fn d_matrix_with_rtcontrib() {
+    let dir = common::scratch("gks-d-ours");
+    for f in ["materials.rad", "room.rad", "exterior.rad", "sky_dmx.rad"] {
+        std::fs::copy(common::fixture(&format!("genklemsamp/{f}")), dir.join(f)).unwrap();
+    }
+    let oct = common::run_ok(common::fenestra("oconv").current_dir(&dir).args([
+        "materials.rad",
+        "room.rad",
+        "exterior.rad",
+        "sky_dmx.rad",
+    ]));
+    std::fs::write(dir.join("dmx.oct"), oct).unwrap();
+    let c = 200;
+    let rays = window_rays(c, "-ff");
+    let mut rc = common::fenestra("rtcontrib");
+    rc.current_dir(&dir).env("RAYPATH", ".").args([
+        "-n",
+        "2",
+        "-c",
+        "200",
+        "-ffa",
+        "-ab",
+        "2",
+        "-ad",
+        "256",
+        "-lw",
+        "1e-3",
+        "-e",
+        "MF:1",
+        "-f",
+        "reinhart.cal",
+        "-b",
+        "rbin",
+        "-bn",
+        "Nrbins",
+        "-m",
+        "skyglow",
+        "dmx.oct",
+    ]);
+    let ours = red_rows(&pipe(rc, &rays));
+    let reference = red_rows(&std::fs::read(common::fixture("threephase/D.dmx")).unwrap());
+    assert_eq!(ours.len(), 145);
+    let (mut ta, mut tb, mut worst) = (0.0, 0.0, 0.0f64);
+    for (k, (a, b)) in ours.iter().zip(&reference).enumerate() {
+        assert_eq!(a.len(), 146);
+        let (sa, sb): (f64, f64) = (a.iter().sum(), b.iter().sum());
+        ta += sa;
+        tb += sb;
+        let p = ((sa + sb) / 2.0).clamp(0.0, 1.0);
+        let se = ((p * (1.0 - p)).max(0.01) * (1.0 / c as f64 + 1.0 / 1000.0)).sqrt();
+        let z = (sa - sb) / se;
+        worst = worst.max(z.abs());
+        assert!(
+            z.abs() < 4.5,
+            "row {k}: ours {sa}, reference {sb} (z = {z:.2})"
+        );
+    }
+    eprintln!(
+        "D row sums (rtcontrib): worst |z| {worst:.2}; totals ours {ta:.3}, reference {tb:.3}"
+    );
+    assert!((ta / tb - 1.0).abs() < 0.01, "totals {ta} {tb}");
+}
