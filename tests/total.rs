@@ -185,3 +185,57 @@ fn bad_input_is_reported() {
         assert!(err.contains(want), "total {args}: '{err}' lacks '{want}'");
     }
 }
+
+/// The reference's annual workflow: the oracle's gendaymtx and dctimestep make `year_res.fmx`
+/// (45 sensors × 8760 hours) as the reference run did; our `rmtxop -fa -c … -t | getinfo - | total`
+/// reproduces the stored `year_ill_sum.dat` byte for byte.
+#[test]
+fn oracle_year_sums_reproduce_stored_reference() {
+    let Some(o) = common::oracle() else { return };
+    let dir = common::scratch("total-year");
+    let tp = common::fixture("threephase");
+    let wea = Command::new("python3")
+        .arg(common::fixture("matrices/gen_year_wea.py"))
+        .output()
+        .expect("python3 runs the reference's .wea generator");
+    assert!(wea.status.success());
+    std::fs::write(dir.join("year.wea"), &wea.stdout).unwrap();
+    let smx = run(
+        o.command("gendaymtx"),
+        &dir,
+        &words("-m 1 -of year.wea"),
+        b"",
+    );
+    assert!(smx.status.success());
+    std::fs::write(dir.join("year.smx"), &smx.stdout).unwrap();
+    let args: Vec<String> = vec![
+        "-of".into(),
+        tp.join("V.vmx").display().to_string(),
+        tp.join("blinds_kf.xml").display().to_string(),
+        tp.join("D.dmx").display().to_string(),
+        "year.smx".into(),
+    ];
+    let res = run(o.command("dctimestep"), &dir, &args, b"");
+    assert!(res.status.success());
+    std::fs::write(dir.join("year_res.fmx"), &res.stdout).unwrap();
+    let exe = std::env::current_exe().unwrap();
+    let bin = exe.parent().unwrap().parent().unwrap().to_path_buf();
+    let b = |t: &str| bin.join(t).display().to_string();
+    let out = Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "{} -fa -c 47.435 119.93 11.635 -t year_res.fmx | {} - | {}",
+            b("rmtxop"),
+            b("getinfo"),
+            b("total")
+        ))
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let want = std::fs::read(common::fixture("matrices/year_ill_sum.dat")).unwrap();
+    assert!(
+        out.stdout == want,
+        "year sums differ from the stored reference"
+    );
+}
