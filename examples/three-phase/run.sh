@@ -8,7 +8,8 @@
 # V (room → window, Klems) and D (window → sky, Reinhart MF 1) are the matrices in matrices/ (see
 # matrices/README.md for how they were made); the scene they describe is in scene/.
 # Usage: examples/three-phase/run.sh   (OUT=dir to choose where results go; FENESTRA_BIN=dir to use
-# already-built binaries instead of building them)
+# already-built binaries instead of building them; MATRICES=fresh to compute V and D first with fenestra's
+# genklemsamp/rtcontrib through matrices.sh, instead of using the bundled ones)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 top=$(cd "$here/../.." && pwd)
@@ -24,11 +25,20 @@ out=${OUT:-$here/out}
 mkdir -p "$out"
 cd "$here"
 
+V=matrices/V.vmx
+D=matrices/D.dmx
+if [ "${MATRICES:-bundled}" = fresh ]; then
+  echo "== phases I and II: matrices.sh (V and D with genklemsamp | rtcontrib, rtcontrib -I)" >&2
+  FENESTRA_BIN="$FENESTRA_BIN" "$here/matrices.sh" "$out/matrices"
+  V="$out/matrices/V.vmx"
+  D="$out/matrices/D.dmx"
+fi
+
 start=$(date +%s.%N)
 echo "== sky matrix: gendaymtx -m 1 weather/sf_year.wea" >&2
 gendaymtx -m 1 weather/sf_year.wea > "$out/sky.smx"
 echo "== time step: dctimestep V blinds_kf.xml D sky | rmtxop -c 47.435 119.93 11.635 (lux)" >&2
-dctimestep matrices/V.vmx matrices/blinds_kf.xml matrices/D.dmx "$out/sky.smx" |
+dctimestep "$V" matrices/blinds_kf.xml "$D" "$out/sky.smx" |
   rmtxop -fa -c 47.435 119.93 11.635 - > "$out/ill.dat"
 end=$(date +%s.%N)
 

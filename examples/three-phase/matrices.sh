@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# fenestra example: phases I and II of the three-phase method for the bundled office, with fenestra's tools only
+# (the commands of docs/three-phase.md):
+#
+#   V  (45 sensors x 145 Klems patches)   oconv … window_vmx.rad; rtcontrib -I+ … -b kbinS -m SouthGroup < sensors.pts
+#   D  (145 Klems patches x 146 sky)      oconv … sky_dmx.rad; genklemsamp … window_out.rad | rtcontrib -c N … -b rbin -m skyglow
+#
+# Usage: examples/three-phase/matrices.sh [OUTDIR]      (default: examples/three-phase/out/matrices)
+# Settings (environment): V_OPTS (default "-ab 6 -ad 50000 -lw 2e-5"), D_OPTS ("-ab 2 -ad 1000 -lw 1e-4"),
+# D_C (rays per Klems patch, 1000) — the parameters of the reference matrices in matrices/; FENESTRA_BIN=dir to use
+# already-built binaries instead of building them.
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+top=$(cd "$here/../.." && pwd)
+if [ -z "${FENESTRA_BIN:-}" ]; then
+  echo "== building fenestra (cargo build --release)" >&2
+  cargo build --release --quiet --manifest-path "$top/Cargo.toml" --bins
+  target=$(cargo metadata --format-version 1 --no-deps --manifest-path "$top/Cargo.toml" |
+    sed -n 's/.*"target_directory":"\([^"]*\)".*/\1/p')
+  FENESTRA_BIN="$target/release"
+fi
+export PATH="$FENESTRA_BIN:$PATH"
+V_OPTS=${V_OPTS:--ab 6 -ad 50000 -lw 2e-5}
+D_OPTS=${D_OPTS:--ab 2 -ad 1000 -lw 1e-4}
+D_C=${D_C:-1000}
+out=${1:-$here/out/matrices}
+mkdir -p "$out"
+out=$(cd "$out" && pwd)
+cd "$here/scene"
+
+echo "== V: rtcontrib -I+ $V_OPTS … -b kbinS -m SouthGroup < sensors.pts" >&2
+oconv materials.rad room.rad window_vmx.rad > "$out/vmx.oct"
+# shellcheck disable=SC2086  # the option strings are meant to be split
+rtcontrib -I+ $V_OPTS -faa -f klems_full.cal -b kbinS -bn Nkbins -m SouthGroup "$out/vmx.oct" \
+  < sensors.pts > "$out/V.vmx"
+
+echo "== D: genklemsamp -c $D_C … | rtcontrib -c $D_C $D_OPTS … -b rbin -m skyglow" >&2
+oconv materials.rad room.rad exterior.rad sky_dmx.rad > "$out/dmx.oct"
+# shellcheck disable=SC2086
+genklemsamp -ff -c "$D_C" -vd 0 -1 0 -vu 0 0 1 window_out.rad |
+  rtcontrib -c "$D_C" -ffa $D_OPTS -e MF:1 -f reinhart.cal -b rbin -bn Nrbins -m skyglow "$out/dmx.oct" \
+  > "$out/D.dmx"
+echo "V and D written to $out" >&2
