@@ -177,7 +177,25 @@ fn oracle_operations_are_byte_identical() {
     for f in ["m23h.txt", "m32h.txt"] {
         std::fs::copy(common::fixture(&format!("matrices/{f}")), dir.join(f)).unwrap();
     }
+    // EXPOSURE lines are undone as a single-precision scale (noted as "Applied scalar").
+    let pic = common::run_ok(
+        o.command("pfilt")
+            .args(["-1", "-e", "0.37"])
+            .arg(tp().join("img_t1_mar21_1000_clear.hdr")),
+    );
+    std::fs::write(dir.join("e.hdr"), pic).unwrap();
+    std::fs::write(
+        dir.join("ex.txt"),
+        "#?RADIANCE\nfoo\nEXPOSURE=3\nEXPOSURE=0.7\nNROWS=1\nNCOLS=4\nNCOMP=3\nFORMAT=ascii\n\n\
+         1 2 3 0.7 1.1 13.7 5 7 11 0.123 100.9 17\n",
+    )
+    .unwrap();
     for case in [
+        "-fa e.hdr",
+        "-ff -s 0.3 e.hdr",
+        "-fa ex.txt",
+        "-fa !cat<ex.txt",
+        "-ff -t !cat<T.mtx",
         "-ff T.mtx D_rflux.dmx test.m1.smx",
         "-ff -t test.m1.smx -t D_rflux.dmx T.mtx",
         "-fa T.mtx . T.mtx . D_rflux.dmx . test.m1.smx",

@@ -41,6 +41,35 @@ pub struct Mtx {
     pub format: DataFormat,
 }
 
+/// Per-component factors undoing `EXPOSURE=` and `COLORCORR=` lines: `1 / (Π exposure ·
+/// Π colorcorr[k])`, the products formed in single precision as Radiance does.
+fn unscale_factors(h: &fenestra_formats::header::Header, ncomp: usize) -> Result<Vec<f32>> {
+    let mut e = 1.0f32;
+    for v in h.get_all("EXPOSURE") {
+        match v.trim().parse::<f64>() {
+            Ok(x) if x > 0.0 && x.is_finite() => e *= x as f32,
+            _ => bail!("bad header line EXPOSURE={v} (expected a positive number)"),
+        }
+    }
+    let mut cc = [1.0f32; 3];
+    for v in h.get_all("COLORCORR") {
+        let w: Vec<f64> = v
+            .split_whitespace()
+            .filter_map(|w| w.parse::<f64>().ok())
+            .filter(|x| *x > 0.0 && x.is_finite())
+            .collect();
+        if w.len() != 3 {
+            bail!("bad header line COLORCORR={v} (expected three positive numbers)");
+        }
+        for (c, x) in cc.iter_mut().zip(&w) {
+            *c *= *x as f32;
+        }
+    }
+    Ok((0..ncomp)
+        .map(|k| (1.0 / (e * cc[if k < 3 { k } else { 1 }]) as f64) as f32)
+        .collect())
+}
+
 /// Whether `name` names a BSDF XML file (by its extension, as Radiance decides).
 pub fn is_xml(name: &str) -> bool {
     !name.starts_with('!')
@@ -68,8 +97,43 @@ impl Mtx {
         if is_xml(name) {
             return Self::load_xml(name, part);
         }
-        let r = MatrixReader::open(name)?;
-        Self::read_from(r)
+        let is_file = !(name.is_empty() || name == "-" || name.starts_with('!'));
+        if is_file {
+            // Files are opened by the matrix reader (size checks, NROWS inferred from the size).
+            let r = MatrixReader::open(name)?;
+            let h = &r.info.header;
+            if h.get("EXPOSURE").is_none() && h.get("COLORCORR").is_none() {
+                return Self::read_from(r);
+            }
+        }
+        // Radiance's rmtxop undoes EXPOSURE/COLORCORR as a single-precision scale of the
+        // raw values: read them unscaled (header without those lines) and scale here.
+        let mut input = fenestra_cli::input::open(name)?;
+        let mut header = fenestra_formats::header::Header::read(&mut input, name)?;
+        let factors = if header.get("EXPOSURE").is_some() || header.get("COLORCORR").is_some() {
+            let ncomp = header.ncomp().ok().flatten().unwrap_or(3);
+            let f = unscale_factors(&header, ncomp)
+                .with_context(|| format!("{name}: bad matrix header"))?;
+            header.remove("EXPOSURE");
+            header.remove("COLORCORR");
+            Some(f)
+        } else {
+            None
+        };
+        let mut bytes = Vec::new();
+        header.write(&mut bytes, None)?;
+        let stream =
+            std::io::BufReader::new(std::io::Read::chain(std::io::Cursor::new(bytes), input));
+        let mut m = Self::read_from(MatrixReader::from_reader(stream, name)?)?;
+        if let Some(factors) = factors {
+            for el in m.data.chunks_exact_mut(m.ncomp) {
+                for (v, &f) in el.iter_mut().zip(&factors) {
+                    *v *= f;
+                }
+            }
+            m.note("Applied scalar");
+        }
+        Ok(m)
     }
 
     /// Reads every row of `r` (memory grows with the data read, not with NROWS).
