@@ -48,6 +48,8 @@ fn spec() -> Spec {
 
 /// Values kept in memory per block of result rows (rows × steps × 3).
 const BLOCK_VALUES: usize = 4 << 20;
+/// Sky panels multiplied at a time inside a block (keeps the partial result in cache).
+const PANELS_PER_GROUP: usize = 64;
 
 struct Opts {
     nsteps: Option<usize>,
@@ -746,15 +748,22 @@ fn matrix_form(
             break;
         }
         let w = left(&vbuf, n)?;
-        let res = multiply(&w, sky, 0..sky.panels())?;
-        let encoded: Vec<Vec<u8>> = (0..n)
-            .into_par_iter()
-            .map(|r| {
-                let vals: Vec<[f64; 3]> = (0..steps)
-                    .map(|t| [res.get(r, t, 0), res.get(r, t, 1), res.get(r, t, 2)])
-                    .collect();
-                Sink::encode(o.out_fmt, ocols, (done + r) * steps, &vals)
-            })
+        // Groups of time steps small enough for the cache, gathered into sensor rows.
+        let mut rows = vec![[0.0f64; 3]; n * steps];
+        let mut p = 0;
+        while p < sky.panels() {
+            let p1 = (p + PANELS_PER_GROUP).min(sky.panels());
+            let res = multiply(&w, sky, p..p1)?;
+            let st = res.steps();
+            rows.par_chunks_mut(steps)
+                .enumerate()
+                .for_each(|(r, row)| res.row_into(r, &mut row[st.clone()]));
+            p = p1;
+        }
+        let encoded: Vec<Vec<u8>> = rows
+            .par_chunks(steps)
+            .enumerate()
+            .map(|(r, vals)| Sink::encode(o.out_fmt, ocols, (done + r) * steps, vals))
             .collect();
         for e in &encoded {
             sink.put(dest.w(), e, steps)?;

@@ -228,6 +228,7 @@ pub struct ResultBlock {
     steps: Range<usize>,
     data: Vec<f64>,
     zero: Vec<bool>,
+    any_zero: bool,
 }
 
 impl ResultBlock {
@@ -245,6 +246,32 @@ impl ResultBlock {
         }
         let p = t / PANEL - self.panel0;
         self.data[((p * 3 + c) * self.rows + r) * PANEL + t % PANEL]
+    }
+}
+
+impl ResultBlock {
+    /// All steps of row `r` written to `dst` (length = number of [`steps`](Self::steps)) as
+    /// RGB triples; all-zero sky steps give exactly +0.
+    pub fn row_into(&self, r: usize, dst: &mut [[f64; 3]]) {
+        assert_eq!(dst.len(), self.steps.len(), "row length");
+        let plane = self.rows * PANEL;
+        for (pi, chunk) in dst.chunks_mut(PANEL).enumerate() {
+            let at = (pi * 3 * self.rows + r) * PANEL;
+            let red = &self.data[at..at + PANEL];
+            let green = &self.data[at + plane..at + plane + PANEL];
+            let blue = &self.data[at + 2 * plane..at + 2 * plane + PANEL];
+            for (j, d) in chunk.iter_mut().enumerate() {
+                *d = [red[j], green[j], blue[j]];
+            }
+        }
+        if self.any_zero {
+            // Steps start on a panel boundary (panel0 · PANEL), so chunk offsets line up.
+            for (d, &z) in dst.iter_mut().zip(&self.zero) {
+                if z {
+                    *d = [0.0; 3];
+                }
+            }
+        }
     }
 }
 
@@ -299,6 +326,7 @@ pub fn multiply(w: &Planar, sky: &PackedSky, panels: Range<usize>) -> Result<Res
         steps: t0..t1,
         data,
         zero: sky.zero[t0..t1].to_vec(),
+        any_zero: sky.zero[t0..t1].iter().any(|&z| z),
     })
 }
 
@@ -400,6 +428,13 @@ mod tests {
             }
         }
         assert_eq!(res.get(0, 4, 0).to_bits(), 0.0f64.to_bits());
+        let mut row = vec![[0.0; 3]; steps];
+        res.row_into(5, &mut row);
+        for (t, v) in row.iter().enumerate() {
+            for (c, x) in v.iter().enumerate() {
+                assert_eq!(x.to_bits(), res.get(5, t, c).to_bits());
+            }
+        }
         // A panel sub-range gives the same numbers.
         let part = multiply(&w, &sky, 1..2).unwrap();
         assert_eq!(part.steps(), 8..16);
