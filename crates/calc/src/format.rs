@@ -12,6 +12,10 @@ pub fn fmt_g(x: f64, prec: usize) -> String {
         return if x.is_sign_negative() { "-0" } else { "0" }.to_string();
     }
     let p = prec.max(1);
+    // integers with at most `p` digits print as themselves (the common case of bin numbers)
+    if x.fract() == 0.0 && p <= 17 && x.abs() < 10f64.powi(p as i32) {
+        return format!("{}", x as i64);
+    }
     let e = format!("{:.*e}", p - 1, x);
     let (mant, exp) = e.split_once('e').unwrap_or((&e, "0"));
     let exp: i32 = exp.parse().unwrap_or(0);
@@ -51,5 +55,9 @@ mod tests {
         assert_eq!(fmt_g(f64::INFINITY, 9), "inf");
         assert_eq!(fmt_g(1e100, 9), "1e+100");
         assert_eq!(fmt_g(100.0, 2), "1e+02");
+        assert_eq!(fmt_g(99.0, 2), "99");
+        assert_eq!(fmt_g(-123456789.0, 9), "-123456789");
+        assert_eq!(fmt_g(1234567890.0, 9), "1.23456789e+09");
+        assert_eq!(fmt_g(-7.0, 9), "-7");
     }
 }
