@@ -721,3 +721,67 @@ fn oracle_specular_and_mixed_basis_xml() {
         assert!(w < PRINT_TOL, "{t:?}: worst relative difference {w}");
     }
 }
+
+/// Picture form errors: components of different sizes and a component that is not a picture
+/// are clear errors naming the files; nothing is written to the output.
+#[test]
+fn picture_form_errors() {
+    use fenestra_formats::picture::{write_picture, PictureHeader};
+    let dir = common::scratch("dctimestep-picture-errors");
+    let pic = |name: &str, w: usize, h: usize| {
+        let mut b = Vec::new();
+        write_picture(
+            &mut b,
+            Some(&PictureHeader::default()),
+            w,
+            h,
+            &vec![[1.0f32, 2.0, 3.0]; w * h],
+        )
+        .unwrap();
+        std::fs::write(dir.join(name), b).unwrap();
+    };
+    pic("a000.hdr", 4, 3);
+    pic("a001.hdr", 4, 3);
+    pic("b000.hdr", 4, 3);
+    pic("b001.hdr", 5, 3);
+    std::fs::write(dir.join("c000.hdr"), mtx(1, 1, |_, _| 1.0)).unwrap();
+    std::fs::write(dir.join("c001.hdr"), mtx(1, 1, |_, _| 1.0)).unwrap();
+    let sky = write(&dir, "sky.mtx", &mtx(2, 1, |r, _| r as f64 + 1.0));
+    // Good case: 1·a0 + 2·a1 per channel (×1, ×2, ×3 channel factors of the sky); RGBE
+    // decoding adds half a mantissa step (1/64 of 27 at exponent 2^5) on input and output.
+    let out = common::fenestra("dctimestep")
+        .current_dir(&dir)
+        .arg("a%03d.hdr")
+        .arg(&sky)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let p = fenestra_formats::picture::Picture::read(&mut &out.stdout[..], "t").unwrap();
+    let want = [3.0f32, 12.0, 27.0];
+    for px in &p.pixels {
+        for c in 0..3 {
+            assert!((px[c] - want[c]).abs() <= 27.0 / 64.0, "{px:?}");
+        }
+    }
+    for (pattern, words) in [
+        ("b%03d.hdr", ["b001.hdr", "5 x 3", "b000.hdr"]),
+        ("c%03d.hdr", ["c000.hdr", "picture", "FORMAT"]),
+    ] {
+        let out = common::fenestra("dctimestep")
+            .current_dir(&dir)
+            .arg(pattern)
+            .arg(&sky)
+            .output()
+            .unwrap();
+        assert!(!out.status.success(), "{pattern}");
+        assert!(out.stdout.is_empty(), "{pattern}: output written");
+        let err = String::from_utf8_lossy(&out.stderr);
+        for w in words {
+            assert!(err.contains(w), "{pattern}: '{err}' lacks '{w}'");
+        }
+    }
+}
