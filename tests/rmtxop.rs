@@ -423,3 +423,38 @@ fn mutated_inputs_never_panic() {
     }
     eprintln!("{runs} mutated runs without a panic");
 }
+
+/// A single large matrix is converted row by row (forced here with a zero limit):
+/// same bytes as the oracle's, with scaling, component transforms and EXPOSURE.
+#[test]
+fn oracle_streamed_conversion_is_identical() {
+    let Some(o) = common::oracle() else { return };
+    let dir = common::scratch("rmtxop-stream");
+    for f in [
+        "T.mtx",
+        "res_t1_mar21_1000_clear.dat",
+        "img_t1_mar21_1000_clear.hdr",
+    ] {
+        std::fs::copy(tp().join(f), dir.join(f)).unwrap();
+    }
+    for case in [
+        "-fa T.mtx",
+        "-ff -c .2 .3 .5 -s 2 T.mtx",
+        "-fd -s 0.3 T.mtx",
+        "-fc T.mtx",
+        "-fa -c 47.435 119.93 11.635 res_t1_mar21_1000_clear.dat",
+        "-fa !cat<res_t1_mar21_1000_clear.dat",
+        "-ff img_t1_mar21_1000_clear.hdr",
+    ] {
+        let a = words(case);
+        let theirs = run(o.command("rmtxop"), &dir, &a);
+        let mut c = common::fenestra("rmtxop");
+        c.env("FENESTRA_RMTXOP_STREAM", "0");
+        let ours = run(c, &dir, &a);
+        assert!(ours.status.success());
+        assert!(
+            theirs.stdout == ours.stdout,
+            "streamed rmtxop {case} differs"
+        );
+    }
+}

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 use fenestra_cli::opts::parse_real;
-use fenestra_dc::ops::{multiply_chain, Mtx, XmlPart};
+use fenestra_dc::ops::{is_xml, multiply_chain, Mtx, Source, XmlPart};
 use fenestra_formats::header::Header;
 use fenestra_formats::matrix::{AsciiLayout, DataFormat, MatrixWriter, WriteOptions};
 
@@ -158,9 +158,77 @@ fn parse(args: &[String]) -> Result<Parsed> {
     })
 }
 
+/// Matrices larger than this many values (1 GB in single precision) given alone and not
+/// transposed are converted row by row instead of being held in memory
+/// (`FENESTRA_RMTXOP_STREAM=values` changes the limit, for tests).
+fn stream_values() -> u128 {
+    std::env::var("FENESTRA_RMTXOP_STREAM")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(1 << 28)
+}
+
+/// Converts a single large input row by row (its size was checked against the header
+/// first for files; an error later in the data leaves a partial result on the output).
+fn stream(p: &Parsed, mut src: Source, args: &[String]) -> Result<ExitCode> {
+    let inp = &p.inputs[0];
+    let apply = |m: &mut Mtx| -> Result<()> {
+        if inp.cmat.is_some() || inp.scale.is_some() {
+            m.transform(inp.cmat.as_deref(), inp.scale.as_deref())
+                .with_context(|| inp.name.clone())?;
+        }
+        Ok(())
+    };
+    let mut shape = src.shape();
+    apply(&mut shape)?;
+    let nrows = src
+        .reader
+        .info
+        .nrows
+        .context("row count needed to stream")?;
+    if p.verbose {
+        eprintln!("rmtxop: converting {} row by row ({nrows} rows)", inp.name);
+    }
+    let opts = output_options(p, &shape, args)?;
+    let stdout = std::io::stdout();
+    let lock = std::io::BufWriter::with_capacity(1 << 16, stdout.lock());
+    let mut w = MatrixWriter::new(lock, Some(nrows), shape.ncols, shape.ncomp, &opts)?;
+    let mut one = src.shape();
+    one.nrows = 1;
+    one.info.clear();
+    let mut raw = vec![0.0f32; src.reader.info.row_len()];
+    let mut out = Vec::new();
+    let mut n = 0;
+    while src.read_row(&mut raw)? {
+        one.ncomp = src.reader.info.ncomp;
+        one.data.clear();
+        one.data.extend_from_slice(&raw);
+        apply(&mut one)?;
+        out.clear();
+        out.extend(one.data.iter().map(|&v| v as f64));
+        w.write_row(&out)?;
+        n += 1;
+    }
+    src.finish(n)?;
+    let mut o = w.finish()?;
+    o.flush()?;
+    Ok(ExitCode::SUCCESS)
+}
+
 /// Loads one input and applies its own options.
 fn load(inp: &Input, verbose: bool) -> Result<Mtx> {
-    let mut m = Mtx::load(&inp.name, inp.part)?;
+    if is_xml(&inp.name) {
+        return load_done(inp, Mtx::load(&inp.name, inp.part)?, verbose);
+    }
+    load_from(inp, Source::open(&inp.name)?, verbose)
+}
+
+/// Reads an opened input whole and applies its own options.
+fn load_from(inp: &Input, src: Source, verbose: bool) -> Result<Mtx> {
+    load_done(inp, Mtx::read_source(src)?, verbose)
+}
+
+fn load_done(inp: &Input, mut m: Mtx, verbose: bool) -> Result<Mtx> {
     if verbose {
         eprintln!(
             "rmtxop: loaded {} ({}×{}, {} components)",
@@ -180,6 +248,19 @@ fn load(inp: &Input, verbose: bool) -> Result<Mtx> {
 /// Runs rmtxop.
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let p = parse(&args)?;
+    if p.inputs.len() == 1 && !p.inputs[0].transpose && !is_xml(&p.inputs[0].name) {
+        let src = Source::open(&p.inputs[0].name)?;
+        let values = src
+            .reader
+            .info
+            .nrows
+            .map(|n| n as u128 * src.reader.info.row_len() as u128);
+        if values.is_some_and(|v| v > stream_values()) {
+            return stream(&p, src, &args);
+        }
+        let m = load_from(&p.inputs[0], src, p.verbose)?;
+        return write_result(&p, m, &args);
+    }
     // Left to right; a run of products is multiplied as one chain (cheapest pair first).
     let mut chain: Vec<(Mtx, String)> = Vec::new();
     for inp in &p.inputs {
@@ -203,6 +284,11 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         chain.push((acc, String::new()));
     }
     let m = reduce_chain(chain, p.verbose)?;
+    write_result(&p, m, &args)
+}
+
+/// The output header and format for a result shaped like `m`.
+fn output_options(p: &Parsed, m: &Mtx, args: &[String]) -> Result<WriteOptions> {
     let format = p.format.unwrap_or(m.format);
     if format.is_picture() && m.ncomp != 3 && m.ncomp != 1 {
         bail!(
@@ -211,17 +297,22 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         );
     }
     let mut h = Header::radiance();
-    h.push(fenestra_cli::command_line(&args));
+    h.push(fenestra_cli::command_line(args));
     for l in &m.info {
         h.push(l.clone());
     }
-    let opts = WriteOptions {
+    Ok(WriteOptions {
         format,
         ascii: AsciiLayout::Rmtxop,
         header: Some(h),
         align_from: stdout_file_offset(),
         ..Default::default()
-    };
+    })
+}
+
+/// Writes a result held in memory.
+fn write_result(p: &Parsed, m: Mtx, args: &[String]) -> Result<ExitCode> {
+    let opts = output_options(p, &m, args)?;
     // The whole result is in memory: nothing is written unless every input was read.
     let stdout = std::io::stdout();
     let lock = std::io::BufWriter::with_capacity(1 << 16, stdout.lock());

@@ -70,6 +70,111 @@ fn unscale_factors(h: &fenestra_formats::header::Header, ncomp: usize) -> Result
         .collect())
 }
 
+/// A matrix input read row by row, with Radiance's rmtxop treatment of `EXPOSURE=` and
+/// `COLORCORR=` (the raw values are scaled in single precision and noted as `Applied scalar`).
+pub struct Source {
+    /// The reader (its header has no EXPOSURE/COLORCORR lines left).
+    pub reader: MatrixReader,
+    factors: Option<Vec<f32>>,
+    buf: Vec<f64>,
+}
+
+impl Source {
+    /// Opens a matrix or picture: a file (sizes checked up front, NROWS of binary data
+    /// inferred from the size), `-` (stdin) or `!command`.
+    pub fn open(name: &str) -> Result<Source> {
+        let is_file = !(name.is_empty() || name == "-" || name.starts_with('!'));
+        if is_file {
+            let r = MatrixReader::open(name)?;
+            let h = &r.info.header;
+            if h.get("EXPOSURE").is_none() && h.get("COLORCORR").is_none() {
+                return Ok(Self::new(r, None));
+            }
+        }
+        // Read the header here; hand the reader a copy without EXPOSURE/COLORCORR so
+        // that it returns raw values.
+        let mut input = fenestra_cli::input::open(name)?;
+        let mut header = fenestra_formats::header::Header::read(&mut input, name)?;
+        let factors = if header.get("EXPOSURE").is_some() || header.get("COLORCORR").is_some() {
+            let ncomp = header.ncomp().ok().flatten().unwrap_or(3);
+            let f = unscale_factors(&header, ncomp)
+                .with_context(|| format!("{name}: bad matrix header"))?;
+            header.remove("EXPOSURE");
+            header.remove("COLORCORR");
+            Some(f)
+        } else {
+            None
+        };
+        let mut bytes = Vec::new();
+        header.write(&mut bytes, None)?;
+        let stream =
+            std::io::BufReader::new(std::io::Read::chain(std::io::Cursor::new(bytes), input));
+        Ok(Self::new(MatrixReader::from_reader(stream, name)?, factors))
+    }
+
+    fn new(reader: MatrixReader, factors: Option<Vec<f32>>) -> Source {
+        let n = reader.info.row_len();
+        Source {
+            reader,
+            factors,
+            buf: vec![0.0; n],
+        }
+    }
+
+    /// An empty matrix (no rows) with this input's columns, components, header lines
+    /// and format.
+    pub fn shape(&self) -> Mtx {
+        let info = &self.reader.info;
+        let mut m = Mtx {
+            nrows: 0,
+            ncols: info.ncols,
+            ncomp: info.ncomp,
+            data: Vec::new(),
+            info: info.retained_header().lines,
+            format: info.format,
+        };
+        if self.factors.is_some() {
+            m.note("Applied scalar");
+        }
+        m
+    }
+
+    /// Reads the next row into `out` (`ncols × ncomp` values); `Ok(false)` at the end.
+    pub fn read_row(&mut self, out: &mut [f32]) -> Result<bool> {
+        if !self.reader.read_row(&mut self.buf)? {
+            return Ok(false);
+        }
+        for (o, &v) in out.iter_mut().zip(&self.buf) {
+            *o = v as f32;
+        }
+        if let Some(f) = &self.factors {
+            for el in out.chunks_exact_mut(f.len()) {
+                for (v, &s) in el.iter_mut().zip(f) {
+                    *v *= s;
+                }
+            }
+        }
+        Ok(true)
+    }
+
+    /// Checks the end of the data after `nrows` rows: no rows at all, or data beyond
+    /// what the header describes, are errors.
+    pub fn finish(&mut self, nrows: usize) -> Result<()> {
+        let info = &self.reader.info;
+        let (ncols, ncomp, announced) = (info.ncols, info.ncomp, info.nrows);
+        if announced.is_none() && nrows == 0 {
+            bail!("{}: no data rows in matrix", self.reader.name());
+        }
+        if self.reader.has_trailing_data() {
+            bail!(
+                "{}: more data than the header's NROWS={nrows} NCOLS={ncols} NCOMP={ncomp} describe (wrong header?)",
+                self.reader.name()
+            );
+        }
+        Ok(())
+    }
+}
+
 /// Whether `name` names a BSDF XML file (by its extension, as Radiance decides).
 pub fn is_xml(name: &str) -> bool {
     !name.starts_with('!')
@@ -97,79 +202,27 @@ impl Mtx {
         if is_xml(name) {
             return Self::load_xml(name, part);
         }
-        let is_file = !(name.is_empty() || name == "-" || name.starts_with('!'));
-        if is_file {
-            // Files are opened by the matrix reader (size checks, NROWS inferred from the size).
-            let r = MatrixReader::open(name)?;
-            let h = &r.info.header;
-            if h.get("EXPOSURE").is_none() && h.get("COLORCORR").is_none() {
-                return Self::read_from(r);
-            }
-        }
-        // Radiance's rmtxop undoes EXPOSURE/COLORCORR as a single-precision scale of the
-        // raw values: read them unscaled (header without those lines) and scale here.
-        let mut input = fenestra_cli::input::open(name)?;
-        let mut header = fenestra_formats::header::Header::read(&mut input, name)?;
-        let factors = if header.get("EXPOSURE").is_some() || header.get("COLORCORR").is_some() {
-            let ncomp = header.ncomp().ok().flatten().unwrap_or(3);
-            let f = unscale_factors(&header, ncomp)
-                .with_context(|| format!("{name}: bad matrix header"))?;
-            header.remove("EXPOSURE");
-            header.remove("COLORCORR");
-            Some(f)
-        } else {
-            None
-        };
-        let mut bytes = Vec::new();
-        header.write(&mut bytes, None)?;
-        let stream =
-            std::io::BufReader::new(std::io::Read::chain(std::io::Cursor::new(bytes), input));
-        let mut m = Self::read_from(MatrixReader::from_reader(stream, name)?)?;
-        if let Some(factors) = factors {
-            for el in m.data.chunks_exact_mut(m.ncomp) {
-                for (v, &f) in el.iter_mut().zip(&factors) {
-                    *v *= f;
-                }
-            }
-            m.note("Applied scalar");
-        }
-        Ok(m)
+        Self::read_source(Source::open(name)?)
     }
 
-    /// Reads every row of `r` (memory grows with the data read, not with NROWS).
-    pub fn read_from(mut r: MatrixReader) -> Result<Mtx> {
-        let info = r.info.clone();
-        let row_len = info.row_len();
+    /// Reads every row of an opened input (memory grows with the data read, not with NROWS).
+    pub fn read_source(mut src: Source) -> Result<Mtx> {
+        let row_len = src.reader.info.row_len();
         let mut data: Vec<f32> = Vec::new();
-        if let Some(n) = info.nrows {
+        if let Some(n) = src.reader.info.nrows {
             data.reserve(n.saturating_mul(row_len).min(1 << 20));
         }
-        let mut row = vec![0.0f64; row_len];
+        let mut row = vec![0.0f32; row_len];
         let mut nrows = 0;
-        while r.read_row(&mut row)? {
-            data.extend(row.iter().map(|&v| v as f32));
+        while src.read_row(&mut row)? {
+            data.extend_from_slice(&row);
             nrows += 1;
         }
-        if info.nrows.is_none() && nrows == 0 {
-            bail!("{}: no data rows in matrix", r.name());
-        }
-        if r.has_trailing_data() {
-            bail!(
-                "{}: more data than the header's NROWS={} NCOLS={} NCOMP={} describe (wrong header?)",
-                r.name(),
-                nrows,
-                info.ncols,
-                info.ncomp
-            );
-        }
-        Ok(Mtx {
-            nrows,
-            ncols: info.ncols,
-            ncomp: info.ncomp,
-            data,
-            info: info.retained_header().lines,
-            format: info.format,
-        })
+        src.finish(nrows)?;
+        let mut m = src.shape();
+        m.nrows = nrows;
+        m.data = data;
+        Ok(m)
     }
 
     fn load_xml(name: &str, part: XmlPart) -> Result<Mtx> {
