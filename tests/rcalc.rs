@@ -482,7 +482,7 @@ fn program(g: &mut Gen) -> String {
 /// Known and documented differences (docs/tools/rcalc.md): Radiance re-associates
 /// chains of `+` and `*`, folds some constant sub-expressions we evaluate at run time,
 /// and its `max`/`min` treat NaN in a way not reproduced; programs whose output depends
-/// on these are printed, and at most 3% may differ (9 of 330 at the time of writing).
+/// on these are printed, and at most 3% may differ (5 of 330 at the time of writing).
 #[test]
 fn oracle_generated_corpus() {
     let Some(o) = common::oracle() else { return };

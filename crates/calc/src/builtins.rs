@@ -146,8 +146,9 @@ impl Math1 {
             Math1::Exp => x.exp(),
             Math1::Log => x.ln(),
             Math1::Log10 => x.log10(),
-            Math1::Floor => x.floor(),
-            Math1::Ceil => x.ceil(),
+            // the oracle's floor/ceil never return -0
+            Math1::Floor => x.floor() + 0.0,
+            Math1::Ceil => x.ceil() + 0.0,
             // SAFETY: plain C math functions of the system libm, pure on their argument.
             Math1::J0 => unsafe { libm::j0(x) },
             // SAFETY: as above.

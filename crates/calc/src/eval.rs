@@ -84,6 +84,10 @@ impl Warnings {
     pub fn messages(&self) -> Vec<String> {
         let mut v = vec!["Division by zero".to_string(); self.division_by_zero as usize];
         for (name, f) in &self.library {
+            if *name == "^" {
+                v.push("Illegal power".to_string());
+                continue;
+            }
             let what = if *f == ErrFlag::Domain {
                 "domain"
             } else {
@@ -588,10 +592,11 @@ impl Compiled {
                     a / b
                 }
             }
-            Node::Pow(p) => {
-                let a = self.eval(&p.0, st, fr);
-                a.powf(self.eval(&p.1, st, fr))
-            }
+            // `^` checks the error flag like a built-in call ("Illegal power", result 0)
+            Node::Pow(p) => self.lib_call(st, "^", |c, st| {
+                let a = c.eval(&p.0, st, fr);
+                a.powf(c.eval(&p.1, st, fr))
+            }),
             Node::If(t) => self.lib_call(st, "if", |c, st| {
                 if c.eval(&t.0, st, fr) > 0.0 {
                     c.eval(&t.1, st, fr)

@@ -91,6 +91,13 @@ impl Cx<'_> {
                                 *op = BinOp::Mul;
                                 **b = Expr::Num(1.0 / y);
                             }
+                            // `x^0` is 1 without evaluating x; `x^1` is x (no power
+                            // computed, so no error-flag check): `x*1` is exactly x
+                            BinOp::Pow if y == 0.0 => return Ok(Lit::Value(1.0)),
+                            BinOp::Pow if y == 1.0 => {
+                                *op = BinOp::Mul;
+                                **b = Expr::Num(1.0);
+                            }
                             _ => **b = Expr::Num(y),
                         }
                         Ok(Lit::Not)
