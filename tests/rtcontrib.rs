@@ -868,3 +868,97 @@ fn oracle_daylight_matrix_agrees_within_mc_error() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+fn rgbe_pixels(file: &[u8]) -> Vec<f64> {
+    let i = file.windows(2).position(|w| w == b"\n\n").unwrap() + 2;
+    let j = i + file[i..].iter().position(|&c| c == b'\n').unwrap() + 1;
+    file[j..]
+        .chunks(4)
+        .map(|p| {
+            if p[3] == 0 {
+                0.0
+            } else {
+                (p[0] as f64 + 0.5) / 256.0 * 2f64.powi(p[3] as i32 - 128)
+            }
+        })
+        .collect()
+}
+
+#[test]
+fn reference_office_picture_v_agrees_with_stored_oracle() {
+    // The picture form of V: vwrays -ff -x 32 -y 32 | rcontrib -ffc -x 32 -y 26 -ab 4 -ad 2000
+    // -lw 5e-4 -o vimg/v%03d.hdr -f klems_full.cal -b kbinS -bn Nkbins -m SouthGroup (reference
+    // commands.sh), against the stored oracle pictures (tests/fixtures/threephase/vimg).
+    // Tolerances from our own seed-to-seed spread on this case: the grand total differs by
+    // 0.01% between seeds and 0.05% from the oracle; per-bin totals by 8.9% rms between seeds
+    // and 9.3% rms from the oracle. We require 1% and 15%.
+    let dir = common::scratch("rtcontrib-pic-v");
+    let view = [
+        "-vtv", "-vp", "2", "4.6", "1.5", "-vd", "0", "-1", "-0.08", "-vu", "0", "0", "1", "-vh",
+        "70", "-vv", "60",
+    ];
+    let mut vw = common::fenestra("vwrays");
+    vw.args(["-ff", "-x", "32", "-y", "32"]).args(view);
+    let rays = common::run_ok(&mut vw);
+    let mut d = common::fenestra("vwrays");
+    d.args(["-d", "-x", "32", "-y", "32"]).args(view);
+    let res = String::from_utf8(common::run_ok(&mut d)).unwrap();
+    assert_eq!(res.trim(), "-x 32 -y 26");
+    let spec = format!("{}/vimg/v%03d.hdr", dir.display());
+    let mut a = vec!["-n", "2", "-ffc"];
+    a.extend(res.split_whitespace());
+    a.extend([
+        "-ab",
+        "4",
+        "-ad",
+        "2000",
+        "-lw",
+        "5e-4",
+        "-o",
+        &spec,
+        "-f",
+        "klems_full.cal",
+        "-b",
+        "kbinS",
+        "-bn",
+        "Nkbins",
+        "-m",
+        "SouthGroup",
+    ]);
+    let scene = office_scene();
+    a.extend(scene.iter().map(String::as_str));
+    ok(rc(&a), &rays);
+    let (mut ta, mut tb) = (0.0, 0.0);
+    let mut rel = Vec::new();
+    for k in 0..145 {
+        let name = format!("v{k:03}.hdr");
+        let ours = std::fs::read(dir.join("vimg").join(&name)).unwrap();
+        let theirs = std::fs::read(common::fixture("threephase/vimg").join(&name)).unwrap();
+        let keys = |t: &[u8]| -> Vec<String> {
+            let s = t.windows(2).position(|w| w == b"\n\n").unwrap();
+            String::from_utf8_lossy(&t[..s + 2 + 24])
+                .lines()
+                .filter(|l| {
+                    ["NCOMP", "MODIFIER", "BIN", "NROWS", "NCOLS", "FORMAT", "-Y"]
+                        .iter()
+                        .any(|k| l.starts_with(k))
+                })
+                .map(str::to_string)
+                .collect()
+        };
+        assert_eq!(keys(&ours), keys(&theirs), "{name}");
+        let (pa, pb) = (rgbe_pixels(&ours), rgbe_pixels(&theirs));
+        assert_eq!(pa.len(), 32 * 26);
+        assert_eq!(pb.len(), 32 * 26);
+        let (sa, sb): (f64, f64) = (pa.iter().sum(), pb.iter().sum());
+        ta += sa;
+        tb += sb;
+        if sb > 0.0 {
+            rel.push((sa - sb) / sb);
+        }
+    }
+    let rms = (rel.iter().map(|r| r * r).sum::<f64>() / rel.len() as f64).sqrt();
+    assert!((ta - tb).abs() < 0.01 * tb, "total {ta} vs {tb}");
+    assert!(rms < 0.15, "per-bin rms {rms}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
