@@ -413,7 +413,10 @@ fn command_line_errors() {
         (vec!["-ab", "0"], "missing required modifier argument"),
         (vec!["-fz", "-m", "skyglow"], "Illegal i/o format"),
         (vec!["-o", "x%f", "-m", "skyglow"], "bad output format"),
-        (vec!["-r", "-m", "skyglow"], "not supported"),
+        (
+            vec!["-r", "-m", "skyglow"],
+            "cannot recover output written to the standard output",
+        ),
         (vec!["-bn", "Nrbins", "-m", "skyglow"], "Nrbins"),
     ] {
         let mut a = args.clone();
@@ -960,5 +963,60 @@ fn reference_office_picture_v_agrees_with_stored_oracle() {
     let rms = (rel.iter().map(|r| r * r).sum::<f64>() / rel.len() as f64).sqrt();
     assert!((ta - tb).abs() < 0.01 * tb, "total {ta} vs {tb}");
     assert!(rms < 0.15, "per-bin rms {rms}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn recover_continues_an_interrupted_binary_run() {
+    // An interrupted run leaves its output under a partial name (.NAME.rtcontrib-partial);
+    // -r keeps its header and complete records, skips the rays they used and appends the
+    // rest: the result is the uninterrupted run's bytes (rays are seeded by their index).
+    // The interruption is simulated by cutting a complete output inside record 8 of 20.
+    let dir = common::scratch("rtcontrib-recover");
+    let sky = fx("sky_uniform.rad");
+    let ground = fx("ground_uniform.rad");
+    let rays = std::fs::read(fx("d_rays.dat")).unwrap();
+    let run = |out: &str, extra: &[&str]| {
+        let o = dir.join(out).display().to_string();
+        let mut a = vec!["-c", "10", "-ab", "1", "-ad", "64", "-fad"];
+        a.extend_from_slice(extra);
+        a.extend(["-o", &o, "-m", "skyglow", "-m", "groundglow", &sky, &ground]);
+        run_in(rc(&a), &rays)
+    };
+    assert!(run("full.dat", &[]).status.success());
+    let full = std::fs::read(dir.join("full.dat")).unwrap();
+    let h = full.windows(2).position(|w| w == b"\n\n").unwrap() + 2;
+    let rec = 2 * 3 * 8;
+    assert_eq!(full.len() - h, 20 * rec);
+    std::fs::write(
+        dir.join(".part.dat.rtcontrib-partial"),
+        &full[..h + 7 * rec + rec / 2],
+    )
+    .unwrap();
+    // a partial output is not silently overwritten
+    let o = run("part.dat", &[]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("-r"));
+    let o = run("part.dat", &["-r"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(std::fs::read(dir.join("part.dat")).unwrap(), full);
+    assert!(!dir.join(".part.dat.rtcontrib-partial").exists());
+    // a complete output is left alone
+    let o = run("part.dat", &["-r"]);
+    assert!(o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("output appears to be complete"));
+    // text output cannot be recovered
+    let o = run_in(
+        rc(&[
+            "-r",
+            "-o",
+            &dir.join("t.txt").display().to_string(),
+            "-m",
+            "skyglow",
+            &sky,
+        ]),
+        b"0 0 0 0 0 1\n",
+    );
+    assert!(String::from_utf8_lossy(&o.stderr).contains("cannot recover ASCII output"));
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -12,7 +12,7 @@ use fenestra_contrib::engine::{
 use fenestra_contrib::output::{self, Format, HeaderInfo, ModOut, Spec, Stream};
 use fenestra_trace::{TraceOptions, Tracer};
 
-const USAGE: &str = "[-n N][-V][-I][-c N][-f{a,f,d}{a,f,d,c}][-fo][-x X -y Y][-o spec][-E][-Eo spec][-Eb N][-p a=1,..][-e expr][-f file.cal][-b binexpr][-bn N] {-m mod | -M file} .. [-ab N -ad N -lw W -lr N -ds V -dj V -st V -ss V -bv -seed N ..] scene.{oct,rad} ..";
+const USAGE: &str = "[-n N][-V][-I][-c N][-f{a,f,d}{a,f,d,c}][-fo|-r][-x X -y Y][-o spec][-E][-Eo spec][-Eb N][-p a=1,..][-e expr][-f file.cal][-b binexpr][-bn N] {-m mod | -M file} .. [-ab N -ad N -lw W -lr N -ds V -dj V -st V -ss V -bv -seed N ..] scene.{oct,rad} ..";
 
 struct ModArg {
     name: String,
@@ -63,6 +63,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let mut o = TraceOptions::rcontrib();
     let (mut irr, mut value, mut header, mut warnings, mut overwrite, mut errors) =
         (false, false, true, true, false, false);
+    let mut recover = false;
     let mut count = 1usize;
     let (mut xres, mut yres, mut nproc, mut batches) = (0usize, 0usize, 1usize, 4usize);
     let (mut fin, mut fout) = (InFormat::Ascii, Format::Ascii);
@@ -142,10 +143,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             if v {
                 bail!("-ld+ (ray length limited by the direction's length) is not supported by fenestra's rtcontrib");
             }
-        } else if let Some(v) = toggle(a, "r", false) {
-            if v {
-                bail!("-r (recover an interrupted run) is not supported by fenestra's rtcontrib: outputs are written whole at the end of a run (no partial files to recover); run again");
-            }
+        } else if let Some(v) = toggle(a, "r", recover) {
+            recover = v;
         } else if a == "-f" {
             defs.push_file(word(&args, i + 1)?)?;
             i += 1;
@@ -375,8 +374,34 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     } else {
         Vec::new()
     };
-    output::check_files(&plans, overwrite)?;
-    output::check_files(&err_plans, overwrite)?;
+    if recover && overwrite {
+        bail!("options -r and -fo are mutually exclusive");
+    }
+    if recover && count == 0 {
+        bail!("-r with -c 0 (continuing a sum) is not supported by fenestra's rtcontrib");
+    }
+    // -r: what the interrupted run left (per stream), and the records all of them hold
+    let mut parts: Vec<Option<output::Partial>> = Vec::new();
+    let mut done_records = 0u64;
+    if recover {
+        for p in plans.iter().chain(&err_plans) {
+            parts.push(output::examine_partial(p, fout)?);
+        }
+        if parts.iter().all(|p| p.is_some_and(|p| p.complete)) {
+            if warnings {
+                fenestra_cli::warn("output appears to be complete");
+            }
+            return Ok(ExitCode::SUCCESS);
+        }
+        done_records = parts
+            .iter()
+            .map(|p| p.map_or(0, |p| p.records))
+            .min()
+            .unwrap_or(0);
+    } else {
+        output::check_files(&plans, overwrite)?;
+        output::check_files(&err_plans, overwrite)?;
+    }
     for p in &err_plans {
         if plans.iter().any(|q| q.name == p.name) {
             bail!(
@@ -407,13 +432,22 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     };
     let mut err_info = info.clone();
     err_info.extra = vec!["CONTENTS= Monte Carlo standard error (1 sigma) of each value".into()];
+    let nplans = plans.len();
+    let open = |k: usize, p: output::StreamPlan, info: &HeaderInfo| -> Result<Stream> {
+        match parts.get(k).copied().flatten() {
+            Some(part) => Stream::resume(p, &part, done_records, fout),
+            None => Stream::open(p, info),
+        }
+    };
     let mut streams: Vec<Stream> = plans
         .into_iter()
-        .map(|p| Stream::open(p, &info))
+        .enumerate()
+        .map(|(k, p)| open(k, p, &info))
         .collect::<Result<_>>()?;
     let mut err_streams: Vec<Stream> = err_plans
         .into_iter()
-        .map(|p| Stream::open(p, &err_info))
+        .enumerate()
+        .map(|(k, p)| open(nplans + k, p, &err_info))
         .collect::<Result<_>>()?;
 
     let opts = RunOptions {
@@ -460,7 +494,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             fenestra_cli::warn("partial accumulation in final record");
         }
         let block = (8192 / count).max(8 * nproc).max(1);
-        let mut r = 0;
+        let mut r = (done_records as usize).min(nrec);
+        progress.inc(((r * count).min(rays.len())) as u64);
         while r < nrec {
             let n = block.min(nrec - r);
             let recs = engine.records(&rays, r, n, &pool)?;

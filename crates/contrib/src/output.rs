@@ -5,7 +5,9 @@ use std::io::Write;
 use std::process::{Child, ChildStdin, Command, Stdio};
 
 use anyhow::{bail, Context, Result};
-use fenestra_cli::output::AtomicFile;
+use std::fs::File;
+use std::io::{BufWriter, Seek, SeekFrom};
+use std::path::{Path, PathBuf};
 
 /// Output data format (`-fXo`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -292,9 +294,161 @@ pub fn header_text(plan: &StreamPlan, info: &HeaderInfo) -> Vec<u8> {
     h.into_bytes()
 }
 
+/// Where an output file is written until the run completes (then renamed over the output).
+/// An interrupted run leaves it behind for `-r`.
+pub fn partial_path(name: &str) -> PathBuf {
+    let p = Path::new(name);
+    let file = p
+        .file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    p.with_file_name(format!(".{file}.rtcontrib-partial"))
+}
+
+/// An output being written under its partial name.
+struct PartialFile {
+    target: PathBuf,
+    tmp: PathBuf,
+    w: Option<BufWriter<File>>,
+}
+
+impl PartialFile {
+    fn create(target: &str) -> Result<PartialFile> {
+        let tmp = partial_path(target);
+        let f = File::create(&tmp)
+            .with_context(|| format!("cannot open '{target}' for writing ({})", tmp.display()))?;
+        Ok(PartialFile {
+            target: PathBuf::from(target),
+            tmp,
+            w: Some(BufWriter::with_capacity(1 << 16, f)),
+        })
+    }
+
+    /// Reopens the partial file of `target`, keeping its first `keep` bytes.
+    fn resume(target: &str, keep: u64) -> Result<PartialFile> {
+        let tmp = partial_path(target);
+        let mut f = std::fs::OpenOptions::new()
+            .write(true)
+            .open(&tmp)
+            .with_context(|| format!("cannot reopen '{}' to recover", tmp.display()))?;
+        f.set_len(keep)?;
+        f.seek(SeekFrom::End(0))?;
+        Ok(PartialFile {
+            target: PathBuf::from(target),
+            tmp,
+            w: Some(BufWriter::with_capacity(1 << 16, f)),
+        })
+    }
+
+    fn commit(mut self) -> Result<()> {
+        if let Some(w) = self.w.take() {
+            let f = w
+                .into_inner()
+                .map_err(|e| anyhow::anyhow!("write error on '{}': {e}", self.target.display()))?;
+            f.sync_all().ok();
+        }
+        std::fs::rename(&self.tmp, &self.target)
+            .with_context(|| format!("cannot rename output into '{}'", self.target.display()))
+    }
+}
+
+impl Write for PartialFile {
+    fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
+        match &mut self.w {
+            Some(w) => w.write(b),
+            None => Ok(0),
+        }
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        match &mut self.w {
+            Some(w) => w.flush(),
+            None => Ok(()),
+        }
+    }
+}
+
+impl Drop for PartialFile {
+    fn drop(&mut self) {
+        // an error (not a kill): no partial output is left behind
+        if self.w.take().is_some() {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
+}
+
+/// Bytes per record of a stream in a binary format (`None` for text).
+pub fn record_size(plan: &StreamPlan, format: Format) -> Option<u64> {
+    let per = match format {
+        Format::Ascii => return None,
+        Format::Float => 12,
+        Format::Double => 24,
+        Format::Rgbe => 4,
+    };
+    Some(per * plan.items.len() as u64)
+}
+
+/// What `-r` found for one output file: the bytes of its header and complete records.
+#[derive(Debug, Clone, Copy)]
+pub struct Partial {
+    /// Header length (with the resolution line of a picture).
+    pub header: u64,
+    /// Complete records present.
+    pub records: u64,
+    /// The output was complete (no partial file): it is moved back to its partial name.
+    pub complete: bool,
+}
+
+/// Examines an output for `-r`: `None` when neither it nor its partial file exists.
+pub fn examine_partial(plan: &StreamPlan, format: Format) -> Result<Option<Partial>> {
+    let Some(name) = plan.name.as_deref() else {
+        bail!("cannot recover output written to the standard output");
+    };
+    if name.starts_with('!') {
+        bail!("cannot recover output written to a command ({name})");
+    }
+    let rs = record_size(plan, format).context("cannot recover ASCII output")?;
+    let tmp = partial_path(name);
+    let (path, complete) = if tmp.exists() {
+        (tmp, false)
+    } else if Path::new(name).exists() {
+        (PathBuf::from(name), true)
+    } else {
+        return Ok(None);
+    };
+    let data = std::fs::read(&path).with_context(|| format!("cannot read '{}'", path.display()))?;
+    // an information header starts with "#?"; without one (-h-) the data start at once
+    let mut h = if data.starts_with(b"#?") {
+        data.windows(2)
+            .position(|w| w == b"\n\n")
+            .map(|p| p + 2)
+            .with_context(|| format!("cannot recover '{name}': incomplete header"))?
+    } else {
+        0
+    };
+    if h > 0 {
+        let head = String::from_utf8_lossy(&data[..h]);
+        let want = format!("FORMAT={}", format.header_name());
+        if !head.lines().any(|l| l == want) {
+            bail!("cannot recover '{name}': its header does not say {want}");
+        }
+    }
+    if data[h..].starts_with(b"-Y ") || data[h..].starts_with(b"+Y ") {
+        match data[h..].iter().position(|&c| c == b'\n') {
+            Some(e) => h += e + 1,
+            None => bail!("cannot recover '{name}': incomplete resolution line"),
+        }
+    }
+    let records = (data.len() - h) as u64 / rs;
+    Ok(Some(Partial {
+        header: h as u64,
+        records,
+        complete,
+    }))
+}
+
 enum Dest {
     Stdout(std::io::BufWriter<std::io::Stdout>),
-    File(AtomicFile),
+    File(PartialFile),
     Cmd(Child, std::io::BufWriter<ChildStdin>, String),
 }
 
@@ -315,6 +469,12 @@ pub fn check_files(plans: &[StreamPlan], overwrite: bool) -> Result<()> {
             }
             if !overwrite && std::path::Path::new(n).exists() {
                 bail!("cannot open '{n}' for writing: the file exists (use -fo to overwrite)");
+            }
+            if !overwrite && partial_path(n).exists() {
+                bail!(
+                    "cannot open '{n}' for writing: '{}' holds the partial output of an interrupted run (continue it with -r, or use -fo to start again)",
+                    partial_path(n).display()
+                );
             }
         }
     }
@@ -351,7 +511,7 @@ impl Stream {
                             .with_context(|| format!("cannot create folder '{}'", dir.display()))?;
                     }
                 }
-                Dest::File(AtomicFile::create(n)?)
+                Dest::File(PartialFile::create(n)?)
             }
         };
         let mut s = Stream {
@@ -361,6 +521,30 @@ impl Stream {
         };
         s.flush_buf()?;
         Ok(s)
+    }
+
+    /// Reopens an output file for `-r`, keeping its header and first `records` records.
+    pub fn resume(
+        plan: StreamPlan,
+        part: &Partial,
+        records: u64,
+        format: Format,
+    ) -> Result<Stream> {
+        let name = plan
+            .name
+            .clone()
+            .context("cannot recover the standard output")?;
+        if part.complete {
+            std::fs::rename(&name, partial_path(&name))
+                .with_context(|| format!("cannot reopen '{name}' to recover"))?;
+        }
+        let rs = record_size(&plan, format).context("cannot recover ASCII output")?;
+        let f = PartialFile::resume(&name, part.header + records * rs)?;
+        Ok(Stream {
+            plan,
+            dest: Dest::File(f),
+            buf: Vec::new(),
+        })
     }
 
     fn w(&mut self) -> &mut dyn Write {
