@@ -1020,3 +1020,90 @@ fn recover_continues_an_interrupted_binary_run() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("cannot recover ASCII output"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn reference_daylight_matrix_agrees_with_stored_oracle_d() {
+    // D = genklemsamp -ff -c N -vd 0 -1 0 -vu 0 0 1 window_out.rad | rcontrib -c N -ffa -ab 2
+    // -ad 1000 -lw 1e-4 -e MF:1 -f reinhart.cal -b rbin -bn Nrbins -m skyglow (reference
+    // commands.sh) with fenestra's genklemsamp and N = 100 instead of the reference's 1000.
+    // Our -E gives se from the 100 rays of each row; the stored oracle D (N = 1000) has about
+    // se/sqrt(10), so the difference has sd se*sqrt(1.1). Measured: 97.2% of 3591 non-zero
+    // values within 3 sd, total within 0.13%. Required: 90% within 3 sd, median z within 0.3,
+    // each row sum (the share of rays reaching the sky, p) within 4 binomial sd
+    // sqrt(p(1-p)(1/100 + 1/1000)) + 1e-3, total within 1%.
+    let dir = common::scratch("rtcontrib-dmx");
+    let mut g = common::fenestra("genklemsamp");
+    g.args([
+        "-ff", "-c", "100", "-vd", "0", "-1", "0", "-vu", "0", "0", "1",
+    ])
+    .arg(fx("window_out.rad"));
+    let rays = common::run_ok(&mut g);
+    assert_eq!(rays.len(), 145 * 100 * 24);
+    let err = dir.join("D.err").display().to_string();
+    let b = common::fixture("rtrace_threephase_bsdf");
+    let scene = [
+        b.join("materials.rad").display().to_string(),
+        b.join("room.rad").display().to_string(),
+        b.join("exterior.rad").display().to_string(),
+        fx("sky_dmx.rad"),
+    ];
+    let mut a = vec![
+        "-n",
+        "2",
+        "-c",
+        "100",
+        "-ffa",
+        "-ab",
+        "2",
+        "-ad",
+        "1000",
+        "-lw",
+        "1e-4",
+        "-e",
+        "MF:1",
+        "-f",
+        "reinhart.cal",
+        "-b",
+        "rbin",
+        "-bn",
+        "Nrbins",
+        "-E",
+        "-Eo",
+        &err,
+        "-m",
+        "skyglow",
+    ];
+    a.extend(scene.iter().map(String::as_str));
+    let ours = matrix_rows(&ok(rc(&a), &rays));
+    let se = matrix_rows(&std::fs::read(&err).unwrap());
+    let theirs = matrix_rows(&std::fs::read(common::fixture("threephase/D.dmx")).unwrap());
+    assert_eq!(ours.len(), 145);
+    assert_eq!(theirs.len(), 145);
+    let mut zs = Vec::new();
+    let (mut ta, mut tb) = (0.0, 0.0);
+    for (k, ((x, e), y)) in ours.iter().zip(&se).zip(&theirs).enumerate() {
+        assert_eq!(x.len(), 146);
+        let (sx, sy): (f64, f64) = (x.iter().sum(), y.iter().sum());
+        ta += sx;
+        tb += sy;
+        let p = sy.clamp(0.0, 1.0);
+        let sd = (p * (1.0 - p) * (0.01 + 0.001)).sqrt();
+        assert!((sx - sy).abs() < 4.0 * sd + 1e-3, "row {k}: {sx} vs {sy}");
+        for ((a, s), b) in x.iter().zip(e).zip(y) {
+            if *s > 0.0 {
+                zs.push((a - b) / (s * 1.1f64.sqrt()));
+            }
+        }
+    }
+    let n = zs.len() as f64;
+    let within = zs.iter().filter(|z| z.abs() < 3.0).count() as f64 / n;
+    zs.sort_by(|a, b| a.total_cmp(b));
+    let median = zs[zs.len() / 2];
+    assert!(
+        n > 2000.0 && within > 0.9,
+        "{n} values, {within} within 3 sd"
+    );
+    assert!(median.abs() < 0.3, "median z {median}");
+    assert!((ta - tb).abs() < 0.01 * tb, "total {ta} vs {tb}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
