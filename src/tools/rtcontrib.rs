@@ -493,7 +493,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         if rays.len() % count != 0 && warnings {
             fenestra_cli::warn("partial accumulation in final record");
         }
-        let block = (8192 / count).max(8 * nproc).max(1);
+        let block = (8192 / count).max(32 * nproc).max(1);
         let mut r = (done_records as usize).min(nrec);
         progress.inc(((r * count).min(rays.len())) as u64);
         while r < nrec {
