@@ -1107,3 +1107,111 @@ fn reference_daylight_matrix_agrees_with_stored_oracle_d() {
     assert!((ta - tb).abs() < 0.01 * tb, "total {ta} vs {tb}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+fn write_matrix(path: &Path, rows: &[Vec<f64>]) {
+    let mut s = format!(
+        "#?RADIANCE\nNROWS={}\nNCOLS={}\nNCOMP=3\nFORMAT=ascii\n\n",
+        rows.len(),
+        rows[0].len()
+    );
+    for r in rows {
+        for v in r {
+            s.push_str(&format!("{v:e}\t{v:e}\t{v:e}\t"));
+        }
+        s.push('\n');
+    }
+    std::fs::write(path, s).unwrap();
+}
+
+fn rgb_rows(text: &[u8]) -> Vec<[f64; 3]> {
+    let v = nums(data_part(text));
+    v.chunks(3).map(|c| [c[0], c[1], c[2]]).collect()
+}
+
+#[test]
+fn reference_office_time_steps_with_our_v_agree_within_mc_error() {
+    // dctimestep V T D s with our V (9 sensors, -ad 50000, -E -Eb 4 as in the V test) and with
+    // the stored oracle V rows of the same sensors, the same T (blinds_kf.xml), D (stored) and
+    // the four reference skies, both through fenestra's dctimestep so only V differs. The
+    // difference's sd per sensor and channel is sqrt(5 * sum_j se_j^2 w_j^2), w = T·D·s (from
+    // dctimestep with an identity V), treating the bins' errors as independent. Required:
+    // all 108 values within 4 sd (measured: max |z| 2.41).
+    let all =
+        std::fs::read_to_string(common::fixture("rtrace_threephase_bsdf").join("sensors.pts"))
+            .unwrap();
+    let pick: Vec<usize> = (2..45).step_by(5).collect();
+    let pts: String = all
+        .lines()
+        .enumerate()
+        .filter(|(k, _)| pick.contains(k))
+        .map(|(_, l)| format!("{l}\n"))
+        .collect();
+    let dir = common::scratch("rtcontrib-dct");
+    let err = dir.join("V.err").display().to_string();
+    let mut a = vec![
+        "-n",
+        "2",
+        "-I+",
+        "-ab",
+        "6",
+        "-ad",
+        "50000",
+        "-lw",
+        "2e-5",
+        "-faa",
+        "-f",
+        "klems_full.cal",
+        "-b",
+        "kbinS",
+        "-bn",
+        "Nkbins",
+        "-E",
+        "-Eo",
+        &err,
+        "-m",
+        "SouthGroup",
+    ];
+    let scene = office_scene();
+    a.extend(scene.iter().map(String::as_str));
+    let ours_v = ok(rc(&a), pts.as_bytes());
+    std::fs::write(dir.join("Vours.vmx"), &ours_v).unwrap();
+    let se = matrix_rows(&std::fs::read(&err).unwrap());
+    let oracle_all = matrix_rows(&std::fs::read(common::fixture("threephase/V.vmx")).unwrap());
+    let oracle: Vec<Vec<f64>> = pick.iter().map(|&k| oracle_all[k].clone()).collect();
+    write_matrix(&dir.join("Voracle.vmx"), &oracle);
+    let ident: Vec<Vec<f64>> = (0..145)
+        .map(|i| (0..145).map(|j| if i == j { 1.0 } else { 0.0 }).collect())
+        .collect();
+    write_matrix(&dir.join("I.vmx"), &ident);
+    let tp = common::fixture("threephase");
+    let mut zmax: f64 = 0.0;
+    for sky in [
+        "sky_t1_mar21_1000_clear.skv",
+        "sky_t2_jun21_1500_clear.skv",
+        "sky_t3_dec21_1200_clear.skv",
+        "sky_t4_sep21_1200_overcast.skv",
+    ] {
+        let dct = |v: &str| {
+            let mut c = common::fenestra("dctimestep");
+            c.arg(dir.join(v))
+                .arg(tp.join("blinds_kf.xml"))
+                .arg(tp.join("D.dmx"))
+                .arg(tp.join(sky));
+            rgb_rows(&common::run_ok(&mut c))
+        };
+        let (ro, rr, w) = (dct("Vours.vmx"), dct("Voracle.vmx"), dct("I.vmx"));
+        assert_eq!(ro.len(), 9);
+        assert_eq!(w.len(), 145);
+        for s in 0..9 {
+            for ch in 0..3 {
+                let var: f64 = (0..145).map(|j| (se[s][j] * w[j][ch]).powi(2)).sum();
+                let sd = (5.0 * var).sqrt();
+                let z = (ro[s][ch] - rr[s][ch]) / sd;
+                zmax = zmax.max(z.abs());
+            }
+        }
+    }
+    eprintln!("time steps: max |z| {zmax:.2} over 108 values");
+    assert!(zmax < 4.0, "max |z| {zmax}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
