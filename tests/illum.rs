@@ -4,27 +4,16 @@
 
 mod common;
 
-use std::io::Write;
-use std::process::{Command, Stdio};
+use std::process::Command;
 
-fn run(mut cmd: Command, input: &[u8]) -> Vec<f64> {
-    let mut child = cmd
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let _ = child.stdin.take().unwrap().write_all(input);
-    let out = child.wait_with_output().unwrap();
+fn run(cmd: Command, input: &[u8]) -> Vec<f64> {
+    let out = common::run_stdin(cmd, input);
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    String::from_utf8_lossy(&out.stdout)
-        .split_whitespace()
-        .map(|w| w.parse().unwrap())
-        .collect()
+    common::numbers(&out.stdout)
 }
 
 #[test]

@@ -3,18 +3,10 @@
 
 mod common;
 
-use std::io::Write;
-use std::process::{Command, Stdio};
+use std::process::Command;
 
-fn run(mut cmd: Command, input: &str) -> std::process::Output {
-    let mut child = cmd
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let _ = child.stdin.take().unwrap().write_all(input.as_bytes());
-    child.wait_with_output().unwrap()
+fn run(cmd: Command, input: &str) -> std::process::Output {
+    common::run_stdin(cmd, input.as_bytes())
 }
 
 const CAL: &str = "{ test patterns }
@@ -59,10 +51,7 @@ fn rays() -> String {
 }
 
 fn values(out: &[u8]) -> Vec<f64> {
-    String::from_utf8_lossy(out)
-        .split_whitespace()
-        .map(|w| w.parse().unwrap())
-        .collect()
+    common::numbers(out)
 }
 
 #[test]

@@ -102,3 +102,38 @@ pub fn run_ok(cmd: &mut Command) -> Vec<u8> {
     );
     out.stdout
 }
+
+/// Runs a command with `input` on its stdin and returns its whole output. A tool that
+/// exits before reading its input (e.g. after rejecting a scene) is not an error here:
+/// the broken pipe is ignored and the exit status tells the rest.
+pub fn run_stdin(mut cmd: Command, input: &[u8]) -> std::process::Output {
+    use std::io::Write;
+    use std::process::Stdio;
+    let mut child = cmd
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap_or_else(|e| panic!("cannot run {cmd:?}: {e}"));
+    let mut stdin = child.stdin.take().expect("stdin");
+    // Feed from a thread so a tool writing much output before reading all its input
+    // cannot deadlock against us.
+    let input = input.to_vec();
+    let feeder = std::thread::spawn(move || {
+        let _ = stdin.write_all(&input);
+    });
+    let out = child.wait_with_output().expect("wait");
+    let _ = feeder.join();
+    out
+}
+
+/// The whitespace-separated numbers of a tool's text output.
+pub fn numbers(out: &[u8]) -> Vec<f64> {
+    String::from_utf8_lossy(out)
+        .split_whitespace()
+        .map(|w| {
+            w.parse()
+                .unwrap_or_else(|_| panic!("not a number in the output: '{w}'"))
+        })
+        .collect()
+}
