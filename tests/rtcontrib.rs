@@ -1215,3 +1215,20 @@ fn reference_office_time_steps_with_our_v_agree_within_mc_error() {
     assert!(zmax < 4.0, "max |z| {zmax}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn defaults_and_version() {
+    let out = String::from_utf8(ok(rc(&["-ad", "1000", "-defaults"]), b"")).unwrap();
+    for l in [
+        "-ab 1 ",
+        "-ad 1000 ",
+        "-lw 2.00e-3",
+        "-dj 0.900000",
+        "-st 0.020000",
+        "-c 1 ",
+    ] {
+        assert!(out.contains(l), "{l} in\n{out}");
+    }
+    let v = String::from_utf8(ok(rc(&["-version"]), b"")).unwrap();
+    assert!(v.starts_with("fenestra "));
+}

@@ -119,6 +119,68 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             files.extend(args[i..].iter().cloned());
             break;
         }
+        if a == "-version" {
+            println!("fenestra {} rtcontrib", env!("CARGO_PKG_VERSION"));
+            return Ok(ExitCode::SUCCESS);
+        }
+        if a == "-defaults" {
+            let pm = |b: bool| if b { '+' } else { '-' };
+            let f = |x: InFormat| match x {
+                InFormat::Ascii => 'a',
+                InFormat::Float => 'f',
+                InFormat::Double => 'd',
+            };
+            let g = match fout {
+                Format::Ascii => 'a',
+                Format::Float => 'f',
+                Format::Double => 'd',
+                Format::Rgbe => 'c',
+            };
+            let lines = [
+                format!("-c {count:<8}\t\t# accumulated rays per record"),
+                format!(
+                    "-V{}\t\t\t\t# output {}",
+                    pm(value),
+                    if value {
+                        "contributions"
+                    } else {
+                        "coefficients"
+                    }
+                ),
+                format!("-n {nproc:<8}\t\t# number of rendering threads"),
+                format!("-x {xres:<8}\t\t# x resolution"),
+                format!("-y {yres:<8}\t\t# y resolution"),
+                format!("-h{}\t\t\t\t# output header", pm(header)),
+                format!("-f{}{}\t\t\t\t# format input/output", f(fin), g),
+                format!("-w{}\t\t\t\t# warning messages", pm(warnings)),
+                format!("-I{}\t\t\t\t# irradiance (point and normal input)", pm(irr)),
+                format!("-E{}\t\t\t\t# standard errors (fenestra)", pm(errors)),
+                format!("-Eb {batches:<8}\t\t# replicas per record for -E with -c 1 (fenestra)"),
+                format!("-bv{}\t\t\t\t# back face visibility", pm(o.bv)),
+                "-dt 0.000000\t\t\t# direct threshold (forced)".to_string(),
+                format!("-dc {:.6}\t\t\t# direct certainty (accepted)", o.dc),
+                format!("-dj {:.6}\t\t\t# direct jitter", o.dj),
+                format!("-ds {:.6}\t\t\t# direct sampling", o.ds),
+                format!("-dr {:<8}\t\t# direct relays (accepted)", o.dr),
+                format!("-ss {:.6}\t\t\t# specular sampling", o.ss),
+                format!("-st {:.6}\t\t\t# specular threshold", o.st),
+                format!(
+                    "-av {:.6} {:.6} {:.6}\t# ambient value",
+                    o.av[0], o.av[1], o.av[2]
+                ),
+                format!("-ab {:<8}\t\t# ambient bounces", o.ab),
+                "-aa 0.000000\t\t\t# ambient accuracy (forced)".to_string(),
+                format!("-ad {:<8}\t\t# ambient divisions", o.ad),
+                "-as 0\t\t\t\t# ambient super-samples (forced)".to_string(),
+                format!("-lr {:<8}\t\t# limit reflection (Russian roulette)", o.lr),
+                format!("-lw {:.2e}\t\t\t# limit weight", o.lw),
+                format!("-seed {:<8}\t\t# random stream seed (fenestra)", o.seed),
+            ];
+            for l in lines {
+                println!("{l}");
+            }
+            return Ok(ExitCode::SUCCESS);
+        }
         if let Some(v) = toggle(a, "V", value) {
             value = v;
         } else if let Some(v) = toggle(a, "I", irr) {
