@@ -1232,3 +1232,22 @@ fn defaults_and_version() {
     let v = String::from_utf8(ok(rc(&["-version"]), b"")).unwrap();
     assert!(v.starts_with("fenestra "));
 }
+
+#[test]
+fn irradiance_at_first_hit() {
+    // -i: a ray from above through the box opening finds the floor centre: pi*F as (a2),
+    // tolerance as there; a ray into the sky gives the glow's coefficient, 1.
+    let scene = [fx("open_box.rad"), fx("sky_uniform.rad")];
+    let mut a = vec![
+        "-h", "-i+", "-ab", "1", "-ad", "65536", "-lw", "1e-6", "-m", "skyglow",
+    ];
+    a.extend(scene.iter().map(String::as_str));
+    let v = nums(&ok(rc(&a), b"0 0 5 0 0 -1\n0 0 5 0 0 1\n"));
+    assert_eq!(v.len(), 6);
+    assert!((v[0] - 1.740840).abs() < 1e-3, "{v:?}");
+    assert_eq!(v[3], 1.0);
+    let mut a = vec!["-I", "-i", "-m", "skyglow"];
+    a.extend(scene.iter().map(String::as_str));
+    let o = run_in(rc(&a), b"");
+    assert!(String::from_utf8_lossy(&o.stderr).contains("mutually exclusive"));
+}

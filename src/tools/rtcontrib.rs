@@ -7,12 +7,12 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use fenestra_contrib::calc::{is_zero_constant, parse_params, BinRequest, Bins, CalcDefs};
 use fenestra_contrib::engine::{
-    read_rays, Engine, InFormat, InputRay, Record, RunOptions, Tracked,
+    read_rays, Engine, HitKind, InFormat, InputRay, Record, RunOptions, Tracked,
 };
 use fenestra_contrib::output::{self, Format, HeaderInfo, ModOut, Spec, Stream};
 use fenestra_trace::{TraceOptions, Tracer};
 
-const USAGE: &str = "[-n N][-V][-I][-c N][-f{a,f,d}{a,f,d,c}][-fo|-r][-x X -y Y][-o spec][-E][-Eo spec][-Eb N][-p a=1,..][-e expr][-f file.cal][-b binexpr][-bn N] {-m mod | -M file} .. [-ab N -ad N -lw W -lr N -ds V -dj V -st V -ss V -bv -seed N ..] scene.{oct,rad} ..";
+const USAGE: &str = "[-n N][-V][-I|-i][-c N][-f{a,f,d}{a,f,d,c}][-fo|-r][-x X -y Y][-o spec][-E][-Eo spec][-Eb N][-p a=1,..][-e expr][-f file.cal][-b binexpr][-bn N] {-m mod | -M file} .. [-ab N -ad N -lw W -lr N -ds V -dj V -st V -ss V -bv -seed N ..] scene.{oct,rad} ..";
 
 struct ModArg {
     name: String,
@@ -64,6 +64,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let (mut irr, mut value, mut header, mut warnings, mut overwrite, mut errors) =
         (false, false, true, true, false, false);
     let mut recover = false;
+    let mut irr_hit = false;
     let mut count = 1usize;
     let (mut xres, mut yres, mut nproc, mut batches) = (0usize, 0usize, 1usize, 4usize);
     let (mut fin, mut fout) = (InFormat::Ascii, Format::Ascii);
@@ -197,10 +198,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             errors = v;
         } else if toggle(a, "u", true).is_some() || toggle(a, "dv", true).is_some() {
             // -u: fenestra's random streams are always keyed by the seed and ray index.
-        } else if let Some(v) = toggle(a, "i", false) {
-            if v {
-                bail!("-i (irradiance at the first intersection) is not supported by fenestra's rtcontrib; use -I with the points and normals");
-            }
+        } else if let Some(v) = toggle(a, "i", irr_hit) {
+            irr_hit = v;
         } else if let Some(v) = toggle(a, "ld", false) {
             if v {
                 bail!("-ld+ (ray length limited by the direction's length) is not supported by fenestra's rtcontrib");
@@ -512,7 +511,29 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         .map(|(k, p)| open(nplans + k, p, &err_info))
         .collect::<Result<_>>()?;
 
+    if irr && irr_hit {
+        bail!("options -I and -i are mutually exclusive");
+    }
+    // -i: which surfaces a ray passes (glass, illum), which emit, which stop it
+    let hit_kinds = irr_hit.then(|| {
+        scene
+            .prims
+            .iter()
+            .map(|p| {
+                let t = p
+                    .modifier
+                    .map(|m| scene.prims[m].ptype.as_str())
+                    .unwrap_or("");
+                match t {
+                    "glass" | "illum" => HitKind::Pass,
+                    "light" | "glow" | "spotlight" => HitKind::Light,
+                    _ => HitKind::Opaque,
+                }
+            })
+            .collect()
+    });
     let opts = RunOptions {
+        irradiance_at_hit: hit_kinds,
         irradiance: irr,
         value,
         count,
