@@ -421,3 +421,49 @@ fn d_matrix_with_rtcontrib() {
     );
     assert!((ta / tb - 1.0).abs() < 0.01, "totals {ta} {tb}");
 }
+
+/// A window group of two panes (areas 1 and 3 m², one given through `!echo`, materials
+/// undefined as Radiance's genklemsamp allows): origins fall on each in proportion to
+/// its area; a polygon at an angle to -vd is left out with a warning.
+#[test]
+fn window_group_area_weighted() {
+    let dir = common::scratch("gks-group");
+    std::fs::write(
+        dir.join("panes.rad"),
+        "glass_a polygon small\n0\n0\n12\n0 0 0  1 0 0  1 0 1  0 0 1\n\
+         !echo glass_b polygon big 0 0 12 2 0 0 5 0 0 5 0 1 2 0 1\n\
+         glass_c polygon tilted\n0\n0\n12\n0 0 0  1 0 0  1 1 1  0 1 1\n",
+    )
+    .unwrap();
+    let out = common::fenestra("genklemsamp")
+        .current_dir(&dir)
+        .args([
+            "-c",
+            "100",
+            "-vd",
+            "0",
+            "-1",
+            "0",
+            "-vu",
+            "0",
+            "0",
+            "1",
+            "panes.rad",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("tilted"));
+    let r = rows(&out.stdout);
+    assert_eq!(r.len(), 14500);
+    let big = r.iter().filter(|x| x[0] >= 2.0).count() as f64 / r.len() as f64;
+    // binomial sd of the share: sqrt(.75*.25/14500) = 0.0036
+    assert!((big - 0.75).abs() < 0.02, "share on the 3 m2 pane {big}");
+    assert!(r
+        .iter()
+        .all(|x| (x[0] <= 1.0 || x[0] >= 2.0) && (0.0..=1.0).contains(&x[2])));
+}
