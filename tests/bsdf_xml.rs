@@ -255,7 +255,7 @@ fn oracle_mixed_bases_and_specular_peak() {
     // the tabulated values through reciprocity: its matrix holds resampled values (not
     // multiples of the table's steps; row sums differ from the table's by up to 7.5%).
     // fenestra uses the table exactly. The shapes agree; the values are not compared.
-    let b = synthetic(
+    let mixed = synthetic(
         quarter,
         half,
         |o, i| ((o * 5 + i) % 13) as f64 * 0.02,
@@ -279,7 +279,7 @@ fn oracle_mixed_bases_and_specular_peak() {
         );
     }
     let p = dir.join("mixed_tb.xml");
-    std::fs::write(&p, klems_xml(&b, None).unwrap()).unwrap();
+    std::fs::write(&p, klems_xml(&mixed, None).unwrap()).unwrap();
     let ours = transmission_matrix(&read_file(&p).unwrap()).unwrap();
     let theirs = oracle_matrix(&o, &p);
     assert_eq!((ours.rows, ours.cols), (theirs.0, theirs.1));

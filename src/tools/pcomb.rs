@@ -316,7 +316,7 @@ fn parse_res(w: &str, axis: &str, sources: &[Source], xmax: usize, ymax: usize) 
     let v = exe
         .eval_expr(&mut exe.state(), e)
         .map_err(|e| anyhow::anyhow!("-{axis} {w}: {e}"))?;
-    if v >= 0.5 && v < 1e8 {
+    if (0.5..1e8).contains(&v) {
         Ok((v + 0.5) as usize)
     } else {
         bail!("-{axis} {w}: the resolution evaluates to {v}")
