@@ -785,3 +785,54 @@ fn picture_form_errors() {
         }
     }
 }
+
+/// `-o name.exr` writes the picture form as OpenEXR: the same pixels as the RGBE picture
+/// (which rounds each pixel to an 8-bit mantissa: within 1% of the largest channel).
+#[test]
+fn picture_form_writes_openexr_by_extension() {
+    use fenestra_formats::picture::Picture;
+    let dir = common::fixture("threephase");
+    let scratch = common::scratch("dctimestep_exr");
+    let exr = scratch.join("img.exr");
+    let args = [
+        "vimg/v%03d.hdr",
+        "blinds_kf.xml",
+        "D.dmx",
+        "sky_t1_mar21_1000_clear.skv",
+    ];
+    let mut c = common::fenestra("dctimestep");
+    c.current_dir(&dir).arg("-o").arg(&exr).args(args);
+    common::run_ok(&mut c);
+    let mut c = common::fenestra("dctimestep");
+    c.current_dir(&dir).args(args);
+    let hdr = common::run_ok(&mut c);
+    let pic = Picture::read(&mut std::io::Cursor::new(hdr), "test").unwrap();
+    let (w, h, want) = pic.to_standard();
+    let img = exr::prelude::read_first_rgba_layer_from_file(
+        &exr,
+        |res, _| {
+            (
+                res.width(),
+                res.height(),
+                vec![[0f32; 3]; res.width() * res.height()],
+            )
+        },
+        |st: &mut (usize, usize, Vec<[f32; 3]>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            let w = st.0;
+            st.2[pos.y() * w + pos.x()] = [r, g, b];
+        },
+    )
+    .unwrap();
+    let (ew, eh, got) = img.layer_data.channel_data.pixels;
+    assert_eq!((ew, eh), (w, h));
+    assert!(want.iter().any(|p| p[1] > 0.0));
+    for (k, (g, q)) in got.iter().zip(&want).enumerate() {
+        let m = q.iter().fold(0f32, |a, b| a.max(*b));
+        for c in 0..3 {
+            assert!(
+                (g[c] - q[c]).abs() <= 0.01 * m + 1e-30,
+                "pixel {k}: exr {g:?} hdr {q:?}"
+            );
+        }
+    }
+}

@@ -869,6 +869,28 @@ fn picture_form(vspec: &str, td: Option<Planar>, sky: &PackedSky, o: &Opts) -> R
                 hb.extend_from_slice(res.to_string().as_bytes());
             }
         }
+        // A picture file named *.exr is written as OpenEXR (one file per time step).
+        let exr_name = match (&per_step, o.out_spec.as_deref()) {
+            (Some(p), _) => Some(format_int_field(p, t)),
+            (None, Some(spec)) if steps == 1 => Some(format_int_field(spec, 0)),
+            _ => None,
+        }
+        .filter(|n| fenestra_formats::exr::is_exr_path(n));
+        if let Some(name) = exr_name {
+            if res.to_string() != Resolution::standard(w, h).to_string() {
+                bail!("{name}: OpenEXR output needs component pictures in standard orientation");
+            }
+            let px: Vec<[f32; 3]> = sum
+                .iter()
+                .map(|v| [v[0] as f32, v[1] as f32, v[2] as f32])
+                .collect();
+            let head = fenestra_formats::picture::PictureHeader {
+                command: Some(o.command.clone()),
+                ..Default::default()
+            };
+            fenestra_formats::exr::write_picture_file(&name, Some(&head), w, h, &px)?;
+            continue;
+        }
         let enc = Sink::encode(DataFormat::Rgbe, ow, 0, &sum);
         match &per_step {
             Some(p) => {
