@@ -9,17 +9,21 @@ use std::f64::consts::PI;
 use std::io::Write;
 use std::process::ExitCode;
 
+fn usage_text() -> String {
+    let p = fenestra_cli::prog();
+    format!(
+        "Usage: {p}      month day hour [-y year]\t[...]\n   or: {p} -ang altitude azimuth\t\t[...]\n\
+         \t\tfollowed by:\t  -P          epsilon delta [options]\n\
+         \t\t\t or:\t  [-W|-L|-G]  direct_value diffuse_value [options]\n\
+         \t\t\t or:\t  -E          global_irradiance [options]\n\
+         \n    Output: -O [0|1|2] (0 = W/sr/m2 visible, 1 = W/sr/m2 solar, 2 = cd/m2), default 0"
+    )
+}
+
 fn usage(msg: &str) -> anyhow::Error {
     let p = fenestra_cli::prog();
     eprintln!("{p}: Use error - {msg}\n");
-    eprintln!("Usage: {p}      month day hour [-y year]\t[...]");
-    eprintln!("   or: {p} -ang altitude azimuth\t\t[...]");
-    eprintln!("\t\tfollowed by:\t  -P          epsilon delta [options]");
-    eprintln!("\t\t\t or:\t  [-W|-L|-G]  direct_value diffuse_value [options]");
-    eprintln!("\t\t\t or:\t  -E          global_irradiance [options]");
-    eprintln!(
-        "\n    Output: -O [0|1|2] (0 = W/sr/m2 visible, 1 = W/sr/m2 solar, 2 = cd/m2), default 0"
-    );
+    eprintln!("{}", usage_text());
     fenestra_cli::Exit(1).into()
 }
 
@@ -47,7 +51,10 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         return Ok(ExitCode::SUCCESS);
     }
     if args.len() == 2 && args[1] == "--help" {
-        let _ = usage("help");
+        println!(
+            "gendaylit: Perez all-weather sky description for one moment\n{}",
+            usage_text()
+        );
         return Ok(ExitCode::SUCCESS);
     }
     if args.len() < 4 {
