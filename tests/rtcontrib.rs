@@ -768,8 +768,9 @@ fn oracle_daylight_matrix_agrees_within_mc_error() {
     // rays; the oracle's value has the same variance, so the difference has sd se*sqrt(2).
     // Measured at -c 1000 -ab 2 -ad 1000 (the reference parameters): 97.5% of 4306 non-zero
     // bins within 2 sd, mean z -0.06. Here we require 90% within 3 sd (50 rays give a rough se
-    // for rare bins; about 300 non-zero values) and every row sum (the share of each bin's rays that reach the sky or
-    // ground, about 0.98) within 1% (measured: within 0.01%).
+    // for rare bins; about 300 non-zero values) and every row sum within 0.01 absolute: both
+    // programs trace the same rays, so direct sky hits agree exactly and only the reflected
+    // part (-ab 1) is Monte Carlo (the oracle seeds from the clock; seen: up to 0.002).
     let Some(o) = common::oracle() else { return };
     let dir = common::scratch("rtcontrib-d");
     let t = "/work/shared/reference/threephase";
@@ -856,7 +857,7 @@ fn oracle_daylight_matrix_agrees_within_mc_error() {
     for ((x, e), y) in ours.iter().zip(&se).zip(&t_out) {
         assert_eq!(x.len(), 146);
         let (sx, sy): (f64, f64) = (x.iter().sum(), y.iter().sum());
-        assert!((sx - sy).abs() < 0.01 * sy, "row sum {sx} vs {sy}");
+        assert!((sx - sy).abs() < 0.01, "row sum {sx} vs {sy}");
         for ((a, s), b) in x.iter().zip(e).zip(y) {
             if *s > 0.0 {
                 zs.push((a - b) / (s * 2f64.sqrt()));
@@ -1250,4 +1251,31 @@ fn irradiance_at_first_hit() {
     a.extend(scene.iter().map(String::as_str));
     let o = run_in(rc(&a), b"");
     assert!(String::from_utf8_lossy(&o.stderr).contains("mutually exclusive"));
+}
+
+#[test]
+fn rtcontrib_without_bn_finds_the_bin_count() {
+    // the older rtcontrib: -bn optional; the count is the highest bin reached + 1
+    let sky = fx("sky_uniform.rad");
+    let mut c = common::fenestra("rtcontrib");
+    c.args([
+        "-h",
+        "-ab",
+        "0",
+        "-e",
+        "b=if(Dz-.5,2,0)",
+        "-b",
+        "b",
+        "-m",
+        "skyglow",
+        &sky,
+    ]);
+    let v = nums(&ok(c, b"0 0 0 0 0 1\n0 0 0 1 0 0.1\n"));
+    assert_eq!(
+        v,
+        vec![
+            0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+            0.0
+        ]
+    );
 }

@@ -16,6 +16,8 @@ const USAGE: &str = "[-n N][-V][-I|-i][-c N][-f{a,f,d}{a,f,d,c}][-fo|-r][-x X -y
 
 struct ModArg {
     name: String,
+    /// rtcontrib without -bn: the bin count is found by a first pass over the input.
+    dynamic: bool,
     spec: Option<Spec>,
     err_spec: Option<Spec>,
     params: Vec<(String, f64)>,
@@ -78,6 +80,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let mut files: Vec<String> = Vec::new();
     let mut first_file = args.len();
     let mut i = 1;
+    let legacy = fenestra_cli::prog() == "rtcontrib";
     let add_mod = |name: &str,
                    mods: &mut Vec<ModArg>,
                    spec: &Option<Spec>,
@@ -98,13 +101,16 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 bail!("illegal non-zero constant for bin ({bin})");
             }
         }
-        let nbins = match nb {
-            Some(n) if n > 0 => n,
-            None if is_zero_constant(bin) => 1,
+        let (nbins, dynamic) = match nb {
+            Some(n) if n > 0 => (n, false),
+            None if is_zero_constant(bin) => (1, false),
+            // the older rtcontrib: -bn optional, the count is what the bins reach
+            None if legacy => (1, true),
             _ => bail!("unspecified or illegal bin count for modifier '{name}'"),
         };
         mods.push(ModArg {
             name: name.to_string(),
+            dynamic,
             spec: spec.clone(),
             err_spec: err.clone(),
             params: params.to_vec(),
@@ -392,6 +398,47 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         })
         .collect();
     let bins = Bins::compile(&defs, &reqs)?;
+    let dynamic = mods.iter().any(|m| m.dynamic);
+
+    // Input.
+    let expect = if yres > 0 {
+        Some(yres * xres.max(1) * count.max(1))
+    } else {
+        None
+    };
+    let stdin = std::io::stdin();
+    let mut rd = std::io::BufReader::with_capacity(1 << 16, stdin.lock());
+    let rays: Vec<InputRay> = read_rays(&mut rd, fin, expect)?;
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(nproc).build()?;
+
+    // rtcontrib without -bn: a first pass over the input finds the bins each such
+    // modifier reaches (rays are seeded by index, so the second pass meets the same ones)
+    if dynamic {
+        let probe_opts = RunOptions {
+            irradiance_at_hit: None,
+            irradiance: irr,
+            value,
+            count: count.max(1),
+            errors: false,
+            batches,
+            nproc,
+        };
+        let probe = Engine::new(&tracer, &bins, scene.prims.len(), &tracked, probe_opts);
+        let c = count.max(1);
+        let nrec = rays.len().div_ceil(c);
+        let mut r = 0;
+        while r < nrec {
+            let n = 256.min(nrec - r);
+            probe.records(&rays, r, n, &pool)?;
+            r += n;
+        }
+        for (m, b) in probe.take_bad_bins() {
+            if mods[m].dynamic {
+                mods[m].nbins = mods[m].nbins.max(b as usize + 1);
+                tracked[m].nbins = mods[m].nbins;
+            }
+        }
+    }
 
     // Output streams.
     let picture = xres > 0 && yres > 0;
@@ -472,16 +519,6 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         }
     }
 
-    // Input.
-    let expect = if yres > 0 {
-        Some(yres * xres.max(1) * count.max(1))
-    } else {
-        None
-    };
-    let stdin = std::io::stdin();
-    let mut rd = std::io::BufReader::with_capacity(1 << 16, stdin.lock());
-    let rays: Vec<InputRay> = read_rays(&mut rd, fin, expect)?;
-
     let info = HeaderInfo {
         scene_lines,
         command: fenestra_cli::command_line(&args[..first_file]),
@@ -542,7 +579,6 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         nproc,
     };
     let engine = Engine::new(&tracer, &bins, scene.prims.len(), &tracked, opts);
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(nproc).build()?;
     let progress = fenestra_cli::progress::Progress::new(rays.len() as u64, fenestra_cli::prog());
     let write = |rec: &Record, streams: &mut [Stream], err_streams: &mut [Stream]| -> Result<()> {
         for s in streams.iter_mut() {
@@ -593,7 +629,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     }
     progress.finish();
     if warnings {
-        for b in engine.take_bad_bins() {
+        for (_, b) in engine.take_bad_bins() {
             fenestra_cli::warn(format!("bad bin number ({b} ignored)"));
         }
     }

@@ -162,7 +162,7 @@ pub struct Engine<'a> {
     nbins: Vec<usize>,
     total: usize,
     opts: RunOptions,
-    bad: Mutex<BTreeSet<i64>>,
+    bad: Mutex<BTreeSet<(usize, i64)>>,
     fail: Mutex<Option<String>>,
 }
 
@@ -219,8 +219,8 @@ impl<'a> Engine<'a> {
         self.offsets[m] + b
     }
 
-    /// Bad bin numbers met so far (for the warning), taken.
-    pub fn take_bad_bins(&self) -> Vec<i64> {
+    /// Bad bin numbers met so far (modifier, bin), for the warning; taken.
+    pub fn take_bad_bins(&self) -> Vec<(usize, i64)> {
         let mut b = self.bad.lock().unwrap_or_else(|e| e.into_inner());
         std::mem::take(&mut *b).into_iter().collect()
     }
@@ -250,7 +250,7 @@ impl<'a> Engine<'a> {
                             self.bad
                                 .lock()
                                 .unwrap_or_else(|e| e.into_inner())
-                                .insert(bn);
+                                .insert((m, bn));
                             return;
                         }
                         bn as usize
