@@ -72,10 +72,18 @@ struct Ctx<'a> {
     sink: Option<&'a mut dyn FnMut(Contribution)>,
 }
 
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Copy)]
 enum SourceGeom {
     Local(usize),
     Distant(usize),
+    /// The image of distant source `base` (index into the sources) in the planar
+    /// mirror `mirror` (a shape): reached only by shadow rays that meet that mirror
+    /// and, reflected there, reach the source (Radiance's virtual sources, one relay).
+    Virtual {
+        base: usize,
+        mirror: usize,
+        dir: DVec3,
+    },
 }
 
 #[derive(Debug, Clone)]
@@ -334,6 +342,31 @@ impl Tracer {
                         mat: d.mat,
                         prim: d.prim,
                     });
+                }
+            }
+        }
+        // Virtual sources: each distant source seen in each planar mirror (-dr > 0).
+        if opts.dr > 0 {
+            let real = sources.len();
+            for (s, &m) in surf_mat.iter().enumerate() {
+                if !matches!(mats[&m], Material::Mirror { .. }) || !shapes[s].is_flat() {
+                    continue;
+                }
+                let n = shapes[s].normal(shapes[s].bounds().0);
+                for b in 0..real {
+                    if let SourceGeom::Distant(k) = sources[b].geom {
+                        let d = distant[k].dir;
+                        let dir = d - n * (2.0 * d.dot(n));
+                        sources.push(Source {
+                            geom: SourceGeom::Virtual {
+                                base: b,
+                                mirror: s,
+                                dir,
+                            },
+                            mat: sources[b].mat,
+                            prim: sources[b].prim,
+                        });
+                    }
                 }
             }
         }
@@ -666,7 +699,7 @@ impl Tracer {
                 let k = match r.src {
                     Some(s) => match self.sources[s].geom {
                         SourceGeom::Distant(k) => Some(k),
-                        SourceGeom::Local(_) => None,
+                        SourceGeom::Local(_) | SourceGeom::Virtual { .. } => None,
                     },
                     None => self.find_distant(r.dir),
                 };
@@ -734,7 +767,7 @@ impl Tracer {
             Material::Bsdf(b) => (self.shade_bsdf(r, b, shape, p, n, t, cx), false),
             Material::Mirror { color } => {
                 if r.flags & SHADOW != 0 {
-                    return (DVec3::ZERO, false);
+                    return (self.relay(r, shape, p, n, rod, t, *color, cx), false);
                 }
                 let nrm = if rod < 0.0 { -n } else { n };
                 let pdot = rod.abs();
@@ -1178,6 +1211,36 @@ impl Tracer {
                         cx,
                     );
                 }
+                SourceGeom::Virtual { base, mirror, dir } => {
+                    if Some(mirror) == shape {
+                        continue;
+                    }
+                    let SourceGeom::Distant(k) = self.sources[base].geom else {
+                        continue;
+                    };
+                    let d = &self.distant[k];
+                    let mut l = dir;
+                    if self.opts.dj > 0.0 {
+                        let (u, v) = (cx.rng.next_f64(), cx.rng.next_f64());
+                        let ct = 1.0 - self.opts.dj * u * (1.0 - d.cos_half);
+                        let st = (1.0 - ct * ct).max(0.0).sqrt();
+                        let (a, b) = frame(dir);
+                        let ph = 2.0 * PI * v;
+                        l = (a * (st * ph.cos()) + b * (st * ph.sin()) + dir * ct).normalize();
+                    }
+                    let ldot = l.dot(nrm);
+                    self.shadow(
+                        r,
+                        p,
+                        l,
+                        f64::INFINITY,
+                        si,
+                        skip,
+                        bsdf(l, d.omega, ldot),
+                        &mut val,
+                        cx,
+                    );
+                }
                 SourceGeom::Local(sh) => {
                     if Some(sh) == shape {
                         continue;
@@ -1214,6 +1277,42 @@ impl Tracer {
             }
         }
         val
+    }
+
+    /// A shadow ray meeting a mirror: if it is aimed at that mirror's image of a distant
+    /// source, it continues, reflected, toward the real source (weighted by the mirror's
+    /// colour); any other shadow ray is stopped.
+    #[allow(clippy::too_many_arguments)]
+    fn relay(
+        &self,
+        r: &Ray,
+        shape: usize,
+        p: DVec3,
+        n: DVec3,
+        rod: f64,
+        t: f64,
+        color: DVec3,
+        cx: &mut Ctx,
+    ) -> DVec3 {
+        let Some(SourceGeom::Virtual { base, mirror, .. }) = r.src.map(|s| self.sources[s].geom)
+        else {
+            return DVec3::ZERO;
+        };
+        if mirror != shape {
+            return DVec3::ZERO;
+        }
+        let nrm = if rod < 0.0 { -n } else { n };
+        let dir = (r.dir + nrm * (2.0 * rod.abs())).normalize();
+        let SourceGeom::Distant(k) = self.sources[base].geom else {
+            return DVec3::ZERO;
+        };
+        if self.distant[k].dir.dot(nrm) <= 0.0 {
+            return DVec3::ZERO;
+        }
+        let mut c = self.child(r, p, dir, 0, color, Some(shape), t);
+        c.weight = r.weight;
+        c.src = Some(base);
+        color * self.trace(&c, cx)
     }
 
     #[allow(clippy::too_many_arguments)]
