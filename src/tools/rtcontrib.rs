@@ -399,6 +399,27 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         .collect();
     let bins = Bins::compile(&defs, &reqs)?;
     let dynamic = mods.iter().any(|m| m.dynamic);
+    if irr && irr_hit {
+        bail!("options -I and -i are mutually exclusive");
+    }
+    // -i: which surfaces a ray passes (glass, illum), which emit, which stop it
+    let hit_kinds = irr_hit.then(|| {
+        scene
+            .prims
+            .iter()
+            .map(|p| {
+                let t = p
+                    .modifier
+                    .map(|m| scene.prims[m].ptype.as_str())
+                    .unwrap_or("");
+                match t {
+                    "glass" | "illum" => HitKind::Pass,
+                    "light" | "glow" | "spotlight" => HitKind::Light,
+                    _ => HitKind::Opaque,
+                }
+            })
+            .collect()
+    });
 
     // Input.
     let expect = if yres > 0 {
@@ -415,7 +436,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     // modifier reaches (rays are seeded by index, so the second pass meets the same ones)
     if dynamic {
         let probe_opts = RunOptions {
-            irradiance_at_hit: None,
+            irradiance_at_hit: hit_kinds.clone(),
             irradiance: irr,
             value,
             count: count.max(1),
@@ -548,27 +569,6 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         .map(|(k, p)| open(nplans + k, p, &err_info))
         .collect::<Result<_>>()?;
 
-    if irr && irr_hit {
-        bail!("options -I and -i are mutually exclusive");
-    }
-    // -i: which surfaces a ray passes (glass, illum), which emit, which stop it
-    let hit_kinds = irr_hit.then(|| {
-        scene
-            .prims
-            .iter()
-            .map(|p| {
-                let t = p
-                    .modifier
-                    .map(|m| scene.prims[m].ptype.as_str())
-                    .unwrap_or("");
-                match t {
-                    "glass" | "illum" => HitKind::Pass,
-                    "light" | "glow" | "spotlight" => HitKind::Light,
-                    _ => HitKind::Opaque,
-                }
-            })
-            .collect()
-    });
     let opts = RunOptions {
         irradiance_at_hit: hit_kinds,
         irradiance: irr,
