@@ -439,13 +439,15 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             irradiance_at_hit: hit_kinds.clone(),
             irradiance: irr,
             value,
-            count: count.max(1),
-            errors: false,
+            // the same random streams as the main pass: replicas with -E -c 1, ray
+            // indices otherwise (-c 0 is probed in records of 256 rays)
+            count: if count == 0 { 256 } else { count },
+            errors,
             batches,
             nproc,
         };
         let probe = Engine::new(&tracer, &bins, scene.prims.len(), &tracked, probe_opts);
-        let c = count.max(1);
+        let c = if count == 0 { 256 } else { count };
         let nrec = rays.len().div_ceil(c);
         let mut r = 0;
         while r < nrec {
