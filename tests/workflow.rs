@@ -28,11 +28,13 @@ fn office(name: &str) -> PathBuf {
         let e = e.unwrap();
         std::fs::copy(e.path(), dir.join("scene").join(e.file_name())).unwrap();
     }
-    std::fs::copy(
-        ex.join("matrices/blinds_kf.xml"),
-        dir.join("matrices/blinds_kf.xml"),
-    )
-    .unwrap();
+    for xml in ["blinds_kf.xml", "clear_glass_kf.xml"] {
+        std::fs::copy(
+            ex.join("matrices").join(xml),
+            dir.join("matrices").join(xml),
+        )
+        .unwrap();
+    }
     std::fs::copy(
         ex.join("weather/sf_year.wea"),
         dir.join("weather/sf_year.wea"),
@@ -99,18 +101,31 @@ fn documented_workflow_runs_verbatim() {
     let scene = dir.join("scene");
     let read =
         |f: &str| std::fs::read_to_string(scene.join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
-    let v = read("V.vmx");
-    assert!(v.contains("NROWS=45") || values(&v).len() == 45, "V rows");
-    assert!(v.contains("NCOLS=145"));
-    let d = read("D.dmx");
-    assert!(d.contains("NCOLS=146"));
-    assert_eq!(values(&d).len(), 145);
-    // one sky: lux per sensor, near what the reference matrices give (res_t1 of the
-    // reference office, converted to lux): the lowered -ab/-ad lose some interreflected
-    // light, so the room mean is compared within 25%
-    let ill = values(&read("ill.dat"));
+    for g in ["SouthGroup", "WestGroup"] {
+        let v = read(&format!("V_{g}.vmx"));
+        assert!(v.contains("NROWS=45") || values(&v).len() == 45, "V rows");
+        assert!(v.contains("NCOLS=145"));
+        let d = read(&format!("D_{g}.dmx"));
+        assert!(d.contains("NCOLS=146"));
+        assert_eq!(values(&d).len(), 145);
+    }
+    // one sky: south-group lux per sensor, near what the reference matrices give (res_t1 of
+    // the reference office, which has no west window, converted to lux): the lowered -ab/-ad
+    // lose some interreflected light, so the room mean is compared within 25%
+    let ill = values(&read("ill_south.dat"));
     assert_eq!(ill.len(), 45);
     assert!(ill.iter().all(|x| x.is_finite() && *x > 0.0));
+    // both groups: the sum is the south group's light plus the west group's
+    let west = values(&read("ill_west.dat"));
+    let both = values(&read("ill.dat"));
+    assert_eq!(both.len(), 45);
+    for k in 0..45 {
+        assert!(
+            (both[k] - ill[k] - west[k]).abs() <= 1e-3 * both[k].max(1.0),
+            "sensor {k}"
+        );
+        assert!(west[k] > 0.0);
+    }
     let reference: Vec<f64> = {
         let t = std::fs::read_to_string(common::fixture("threephase/res_t1_mar21_1000_clear.dat"))
             .unwrap();
@@ -134,7 +149,10 @@ fn documented_workflow_runs_verbatim() {
     let annual = read("annual_ill.dat");
     assert!(annual.contains("NROWS=45") && annual.contains("NCOLS=8760"));
     // the picture: 145 V pictures and the result
-    assert!(scene.join("vimg/v000.hdr").is_file() && scene.join("vimg/v144.hdr").is_file());
+    for g in ["SouthGroup", "WestGroup"] {
+        assert!(scene.join(format!("vimg/{g}_000.hdr")).is_file());
+        assert!(scene.join(format!("vimg/{g}_144.hdr")).is_file());
+    }
     let pic = std::fs::read(scene.join("window_light.hdr")).unwrap();
     assert!(pic.starts_with(b"#?RADIANCE"));
     let text = String::from_utf8_lossy(&pic);
@@ -164,8 +182,10 @@ fn matrices_script_writes_v_and_d() {
         "matrices.sh failed: {}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let v = std::fs::read_to_string(dir.join("out/V.vmx")).unwrap();
-    let d = std::fs::read_to_string(dir.join("out/D.dmx")).unwrap();
-    assert_eq!(values(&v).len(), 45);
-    assert_eq!(values(&d).len(), 145);
+    for g in ["SouthGroup", "WestGroup"] {
+        let v = std::fs::read_to_string(dir.join(format!("out/V_{g}.vmx"))).unwrap();
+        let d = std::fs::read_to_string(dir.join(format!("out/D_{g}.dmx"))).unwrap();
+        assert_eq!(values(&v).len(), 45);
+        assert_eq!(values(&d).len(), 145);
+    }
 }

@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
-# fenestra example: phases I and II of the three-phase method for the bundled office, with fenestra's tools only
-# (the commands of docs/three-phase.md):
+# fenestra example: phases I and II of the three-phase method for the bundled office (two window groups: south with
+# a venetian blind, west with clear glazing), with fenestra's tools only (the commands of docs/three-phase.md):
 #
-#   V  (45 sensors x 145 Klems patches)   oconv … window_vmx.rad; rtcontrib -I+ … -b kbinS -m SouthGroup < sensors.pts
-#   D  (145 Klems patches x 146 sky)      oconv … sky_dmx.rad; genklemsamp … window_out.rad | rtcontrib -c N … -b rbin -m skyglow
+#   V  (45 sensors x 145 Klems patches, per group)  oconv … window_vmx.rad window_west_vmx.rad;
+#        rtcontrib -I+ … -o V_%s.vmx -b kbinS -m SouthGroup -b kbinW -m WestGroup < sensors.pts
+#   D  (145 Klems patches x 146 sky, per group)     oconv … sky_dmx.rad;
+#        genklemsamp … window_out.rad | rtcontrib -c N … -b rbin -m skyglow   (and window_west_out.rad)
 #
 # Usage: examples/three-phase/matrices.sh [OUTDIR]      (default: examples/three-phase/out/matrices)
 # Settings (environment): V_OPTS (default "-ab 6 -ad 50000 -lw 2e-5"), D_OPTS ("-ab 2 -ad 1000 -lw 1e-4"),
@@ -28,16 +30,20 @@ mkdir -p "$out"
 out=$(cd "$out" && pwd)
 cd "$here/scene"
 
-echo "== V: rtcontrib -I+ $V_OPTS … -b kbinS -m SouthGroup < sensors.pts" >&2
-oconv materials.rad room.rad window_vmx.rad > "$out/vmx.oct"
+echo "== V: rtcontrib -I+ $V_OPTS … -b kbinS -m SouthGroup -b kbinW -m WestGroup < sensors.pts" >&2
+oconv materials.rad room.rad window_vmx.rad window_west_vmx.rad > "$out/vmx.oct"
 # shellcheck disable=SC2086  # the option strings are meant to be split
-rtcontrib -I+ $V_OPTS -faa -f klems_full.cal -b kbinS -bn Nkbins -m SouthGroup "$out/vmx.oct" \
-  < sensors.pts > "$out/V.vmx"
+rtcontrib -fo -I+ $V_OPTS -faa -f klems_full.cal -bn Nkbins -o "$out/V_%s.vmx" \
+  -b kbinS -m SouthGroup -b kbinW -m WestGroup "$out/vmx.oct" < sensors.pts
 
-echo "== D: genklemsamp -c $D_C … | rtcontrib -c $D_C $D_OPTS … -b rbin -m skyglow" >&2
 oconv materials.rad room.rad exterior.rad sky_dmx.rad > "$out/dmx.oct"
-# shellcheck disable=SC2086
-genklemsamp -ff -c "$D_C" -vd 0 -1 0 -vu 0 0 1 window_out.rad |
-  rtcontrib -c "$D_C" -ffa $D_OPTS -e MF:1 -f reinhart.cal -b rbin -bn Nrbins -m skyglow "$out/dmx.oct" \
-  > "$out/D.dmx"
-echo "V and D written to $out" >&2
+for group in "SouthGroup window_out.rad 0 -1 0" "WestGroup window_west_out.rad -1 0 0"; do
+  # shellcheck disable=SC2086
+  set -- $group
+  echo "== D $1: genklemsamp -c $D_C -vd $3 $4 $5 $2 | rtcontrib -c $D_C $D_OPTS … -b rbin -m skyglow" >&2
+  # shellcheck disable=SC2086
+  genklemsamp -ff -c "$D_C" -vd "$3" "$4" "$5" -vu 0 0 1 "$2" |
+    rtcontrib -c "$D_C" -ffa $D_OPTS -e MF:1 -f reinhart.cal -b rbin -bn Nrbins -m skyglow "$out/dmx.oct" \
+    > "$out/D_$1.dmx"
+done
+echo "V_SouthGroup.vmx, V_WestGroup.vmx, D_SouthGroup.dmx, D_WestGroup.dmx written to $out" >&2

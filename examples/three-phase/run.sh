@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# fenestra example: a three-phase annual run on the bundled office (south window with a venetian blind).
+# fenestra example: a three-phase annual run on the bundled office (south window with a venetian blind, west window
+# with clear glazing).
 #
 #   sky matrix s   gendaymtx -m 1 weather/sf_year.wea                     (146 Reinhart patches x 8760 hours)
-#   time step      dctimestep V blinds_kf.xml D s | rmtxop -c … (lux)     (45 sensors x 8760 hours)
+#   time step      per window group dctimestep V T D s, summed by rmtxop, -c … to lux (45 sensors x 8760 hours):
+#                  south window with a venetian blind (blinds_kf.xml), west window with clear glass (clear_glass_kf.xml)
 #   metrics        per sensor: daylight autonomy (share of working hours 8-18 h with >= 300 lux), mean lux
 #
 # V (room → window, Klems) and D (window → sky, Reinhart MF 1) are the matrices in matrices/ (see
@@ -25,20 +27,19 @@ out=${OUT:-$here/out}
 mkdir -p "$out"
 cd "$here"
 
-V=matrices/V.vmx
-D=matrices/D.dmx
+m=matrices
 if [ "${MATRICES:-bundled}" = fresh ]; then
-  echo "== phases I and II: matrices.sh (V and D with genklemsamp | rtcontrib, rtcontrib -I)" >&2
+  echo "== phases I and II: matrices.sh (V and D of both window groups with genklemsamp | rtcontrib, rtcontrib -I)" >&2
   FENESTRA_BIN="$FENESTRA_BIN" "$here/matrices.sh" "$out/matrices"
-  V="$out/matrices/V.vmx"
-  D="$out/matrices/D.dmx"
+  m="$out/matrices"
 fi
 
 start=$(date +%s.%N)
 echo "== sky matrix: gendaymtx -m 1 weather/sf_year.wea" >&2
 gendaymtx -m 1 weather/sf_year.wea > "$out/sky.smx"
-echo "== time step: dctimestep V blinds_kf.xml D sky | rmtxop -c 47.435 119.93 11.635 (lux)" >&2
-dctimestep "$V" matrices/blinds_kf.xml "$D" "$out/sky.smx" |
+echo "== time step: dctimestep V T D sky per window group (south: blind, west: clear), summed, to lux" >&2
+rmtxop -ff "!dctimestep $m/V_SouthGroup.vmx matrices/blinds_kf.xml $m/D_SouthGroup.dmx $out/sky.smx" \
+  + "!dctimestep $m/V_WestGroup.vmx matrices/clear_glass_kf.xml $m/D_WestGroup.dmx $out/sky.smx" |
   rmtxop -fa -c 47.435 119.93 11.635 - > "$out/ill.dat"
 end=$(date +%s.%N)
 
