@@ -22,6 +22,7 @@ if [ -z "${FENESTRA_BIN:-}" ]; then
   FENESTRA_BIN="$target/release"
 fi
 export PATH="$FENESTRA_BIN:$PATH"
+nproc=$(nproc 2>/dev/null || echo 2)
 V_OPTS=${V_OPTS:--ab 6 -ad 50000 -lw 2e-5}
 D_OPTS=${D_OPTS:--ab 2 -ad 1000 -lw 1e-4}
 D_C=${D_C:-1000}
@@ -33,7 +34,7 @@ cd "$here/scene"
 echo "== V: rtcontrib -I+ $V_OPTS … -b kbinS -m SouthGroup -b kbinW -m WestGroup < sensors.pts" >&2
 oconv materials.rad room.rad window_vmx.rad window_west_vmx.rad > "$out/vmx.oct"
 # shellcheck disable=SC2086  # the option strings are meant to be split
-rtcontrib -fo -I+ $V_OPTS -faa -f klems_full.cal -bn Nkbins -o "$out/V_%s.vmx" \
+rtcontrib -n "$nproc" -fo -I+ $V_OPTS -faa -f klems_full.cal -bn Nkbins -o "$out/V_%s.vmx" \
   -b kbinS -m SouthGroup -b kbinW -m WestGroup "$out/vmx.oct" < sensors.pts
 
 oconv materials.rad room.rad exterior.rad sky_dmx.rad > "$out/dmx.oct"
@@ -43,7 +44,7 @@ for group in "SouthGroup window_out.rad 0 -1 0" "WestGroup window_west_out.rad -
   echo "== D $1: genklemsamp -c $D_C -vd $3 $4 $5 $2 | rtcontrib -c $D_C $D_OPTS … -b rbin -m skyglow" >&2
   # shellcheck disable=SC2086
   genklemsamp -ff -c "$D_C" -vd "$3" "$4" "$5" -vu 0 0 1 "$2" |
-    rtcontrib -c "$D_C" -ffa $D_OPTS -e MF:1 -f reinhart.cal -b rbin -bn Nrbins -m skyglow "$out/dmx.oct" \
+    rtcontrib -n "$nproc" -c "$D_C" -ffa $D_OPTS -e MF:1 -f reinhart.cal -b rbin -bn Nrbins -m skyglow "$out/dmx.oct" \
     > "$out/D_$1.dmx"
 done
 echo "V_SouthGroup.vmx, V_WestGroup.vmx, D_SouthGroup.dmx, D_WestGroup.dmx written to $out" >&2

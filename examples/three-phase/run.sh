@@ -7,11 +7,12 @@
 #                  south window with a venetian blind (blinds_kf.xml), west window with clear glass (clear_glass_kf.xml)
 #   metrics        per sensor: daylight autonomy (share of working hours 8-18 h with >= 300 lux), mean lux
 #
-# V (room → window, Klems) and D (window → sky, Reinhart MF 1) are the matrices in matrices/ (see
-# matrices/README.md for how they were made); the scene they describe is in scene/.
+#   phases I, II   matrices.sh: V (room → window, Klems) with rtcontrib -I, D (window → sky, Reinhart MF 1) with
+#                  genklemsamp | rtcontrib, per window group (scene/); matrices/ holds the same at these settings
+#   picture        21 March 10:00: vwrays | rtcontrib -ffc (V per pixel), dctimestep per group, pcomb
 # Usage: examples/three-phase/run.sh   (OUT=dir to choose where results go; FENESTRA_BIN=dir to use
-# already-built binaries instead of building them; MATRICES=fresh to compute V and D first with fenestra's
-# genklemsamp/rtcontrib through matrices.sh, instead of using the bundled ones)
+# already-built binaries instead of building them; MATRICES=bundled to use the bundled V and D instead of
+# computing them first with fenestra's genklemsamp/rtcontrib through matrices.sh)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 top=$(cd "$here/../.." && pwd)
@@ -23,24 +24,41 @@ if [ -z "${FENESTRA_BIN:-}" ]; then
   FENESTRA_BIN="$target/release"
 fi
 export PATH="$FENESTRA_BIN:$PATH"
+nproc=$(nproc 2>/dev/null || echo 2)
 out=${OUT:-$here/out}
 mkdir -p "$out"
 cd "$here"
 
+start=$(date +%s.%N)
 m=matrices
-if [ "${MATRICES:-bundled}" = fresh ]; then
+if [ "${MATRICES:-fresh}" = fresh ]; then
   echo "== phases I and II: matrices.sh (V and D of both window groups with genklemsamp | rtcontrib, rtcontrib -I)" >&2
   FENESTRA_BIN="$FENESTRA_BIN" "$here/matrices.sh" "$out/matrices"
   m="$out/matrices"
 fi
 
-start=$(date +%s.%N)
 echo "== sky matrix: gendaymtx -m 1 weather/sf_year.wea" >&2
 gendaymtx -m 1 weather/sf_year.wea > "$out/sky.smx"
 echo "== time step: dctimestep V T D sky per window group (south: blind, west: clear), summed, to lux" >&2
 rmtxop -ff "!dctimestep $m/V_SouthGroup.vmx matrices/blinds_kf.xml $m/D_SouthGroup.dmx $out/sky.smx" \
   + "!dctimestep $m/V_WestGroup.vmx matrices/clear_glass_kf.xml $m/D_WestGroup.dmx $out/sky.smx" |
   rmtxop -fa -c 47.435 119.93 11.635 - > "$out/ill.dat"
+
+echo "== one moment as a picture: V per pixel (vwrays | rtcontrib -ffc, both groups), dctimestep per group, pcomb" >&2
+gensky 3 21 10 +s -a 37.71 -o 122.21 -m 120 | genskyvec -m 1 > "$out/sky_0321_1000.skv"
+mkdir -p "$out/vimg"
+(
+  cd scene
+  oconv materials.rad room.rad window_vmx.rad window_west_vmx.rad > "$out/vimg/vmx.oct"
+  # shellcheck disable=SC2046  # vwrays -d prints the -x -y options rtcontrib needs
+  vwrays -ff -vf view.vf -x 64 -y 64 |
+    rtcontrib -n "$nproc" -fo $(vwrays -vf view.vf -x 64 -y 64 -d) -ffc -ab 2 -ad 256 -lw 1e-3 \
+      -o "$out/vimg/%s_%03d.hdr" -f klems_full.cal -bn Nkbins -b kbinS -m SouthGroup -b kbinW -m WestGroup \
+      "$out/vimg/vmx.oct"
+)
+pcomb "!dctimestep $out/vimg/SouthGroup_%03d.hdr matrices/blinds_kf.xml $m/D_SouthGroup.dmx $out/sky_0321_1000.skv" \
+  "!dctimestep $out/vimg/WestGroup_%03d.hdr matrices/clear_glass_kf.xml $m/D_WestGroup.dmx $out/sky_0321_1000.skv" \
+  > "$out/view_0321_1000.hdr"
 end=$(date +%s.%N)
 
 echo "== annual metrics per sensor (working hours 8-18 h local standard time)"
@@ -67,4 +85,5 @@ awk -v WEA=weather/sf_year.wea -v PTS=scene/sensors.pts '
   }
   END { if (row) printf "room: mean DA300 %.1f %% over %d sensors\n", 100 * da / row, row }
 ' "$out/ill.dat"
-awk -v a="$start" -v b="$end" -v o="$out" 'BEGIN { printf "time for sky matrix + time step: %.2f s (results in %s)\n", b - a, o }'
+echo "picture of 21 March 10:00 (radiance through both windows, as seen from the back of the room): $out/view_0321_1000.hdr"
+awk -v a="$start" -v b="$end" -v o="$out" 'BEGIN { printf "time for the pipeline (matrices, sky matrix, time steps, picture): %.2f s (results in %s)\n", b - a, o }'
