@@ -1188,16 +1188,7 @@ impl Tracer {
             match s.geom {
                 SourceGeom::Distant(k) => {
                     let d = &self.distant[k];
-                    let mut l = d.dir;
-                    if self.opts.dj > 0.0 {
-                        // jitter within the cone
-                        let (u, v) = (cx.rng.next_f64(), cx.rng.next_f64());
-                        let ct = 1.0 - self.opts.dj * u * (1.0 - d.cos_half);
-                        let st = (1.0 - ct * ct).max(0.0).sqrt();
-                        let (a, b) = frame(d.dir);
-                        let ph = 2.0 * PI * v;
-                        l = (a * (st * ph.cos()) + b * (st * ph.sin()) + d.dir * ct).normalize();
-                    }
+                    let l = self.jitter_cone(d.dir, d.cos_half, cx);
                     let ldot = l.dot(nrm);
                     self.shadow(
                         r,
@@ -1219,15 +1210,7 @@ impl Tracer {
                         continue;
                     };
                     let d = &self.distant[k];
-                    let mut l = dir;
-                    if self.opts.dj > 0.0 {
-                        let (u, v) = (cx.rng.next_f64(), cx.rng.next_f64());
-                        let ct = 1.0 - self.opts.dj * u * (1.0 - d.cos_half);
-                        let st = (1.0 - ct * ct).max(0.0).sqrt();
-                        let (a, b) = frame(dir);
-                        let ph = 2.0 * PI * v;
-                        l = (a * (st * ph.cos()) + b * (st * ph.sin()) + dir * ct).normalize();
-                    }
+                    let l = self.jitter_cone(dir, d.cos_half, cx);
                     let ldot = l.dot(nrm);
                     self.shadow(
                         r,
@@ -1277,6 +1260,20 @@ impl Tracer {
             }
         }
         val
+    }
+
+    /// A direction toward a distant source: its centre, or with `-dj` a point jittered
+    /// within the source's cone.
+    fn jitter_cone(&self, dir: DVec3, cos_half: f64, cx: &mut Ctx) -> DVec3 {
+        if self.opts.dj <= 0.0 {
+            return dir;
+        }
+        let (u, v) = (cx.rng.next_f64(), cx.rng.next_f64());
+        let ct = 1.0 - self.opts.dj * u * (1.0 - cos_half);
+        let st = (1.0 - ct * ct).max(0.0).sqrt();
+        let (a, b) = frame(dir);
+        let ph = 2.0 * PI * v;
+        (a * (st * ph.cos()) + b * (st * ph.sin()) + dir * ct).normalize()
     }
 
     /// A shadow ray meeting a mirror: if it is aimed at that mirror's image of a distant
