@@ -1279,3 +1279,72 @@ fn rtcontrib_without_bn_finds_the_bin_count() {
         ]
     );
 }
+
+/// Picture outputs named `*.exr` are written as OpenEXR: the same pixels as the RGBE
+/// picture, unrounded (RGBE keeps an 8-bit mantissa: within 1% of the largest channel).
+#[test]
+fn picture_output_to_openexr() {
+    let dir = common::scratch("rtcontrib_exr");
+    let sky = common::fixture("rcontrib/sky_uniform.rad");
+    let mut rays = Vec::new();
+    for y in 0..6 {
+        for x in 0..8 {
+            let (dx, dz) = (x as f32 / 8.0 - 0.45, 0.2 + y as f32 / 6.0);
+            for v in [0.0f32, 0.0, 0.0, dx, 1.0, dz] {
+                rays.extend_from_slice(&v.to_ne_bytes());
+            }
+        }
+    }
+    for ext in ["hdr", "exr"] {
+        let mut c = common::fenestra("rtcontrib");
+        c.args([
+            "-ffc",
+            "-x",
+            "8",
+            "-y",
+            "6",
+            "-ab",
+            "0",
+            "-e",
+            "b=if(Dx,1,0)",
+        ])
+        .args(["-bn", "2", "-b", "b", "-o"])
+        .arg(format!("p_%d.{ext}"))
+        .args(["-m", "skyglow"])
+        .arg(&sky)
+        .current_dir(&dir);
+        let out = common::run_stdin(c, &rays);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    for bin in 0..2 {
+        let hdr = std::fs::read(dir.join(format!("p_{bin}.hdr"))).unwrap();
+        let pic =
+            fenestra_formats::picture::Picture::read(&mut std::io::Cursor::new(hdr), "t").unwrap();
+        let (w, h, want) = pic.to_standard();
+        let img = exr::prelude::read_first_rgba_layer_from_file(
+            dir.join(format!("p_{bin}.exr")),
+            |res, _| (res.width(), vec![[0f32; 3]; res.width() * res.height()]),
+            |st: &mut (usize, Vec<[f32; 3]>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                let w = st.0;
+                st.1[pos.y() * w + pos.x()] = [r, g, b];
+            },
+        )
+        .unwrap();
+        let (ew, got) = img.layer_data.channel_data.pixels;
+        assert_eq!((ew, got.len()), (w, w * h));
+        assert!(want.iter().any(|p| p[0] > 0.0), "bin {bin}: some sky seen");
+        for (g, q) in got.iter().zip(&want) {
+            let m = q.iter().fold(0f32, |a, b| a.max(*b));
+            for c in 0..3 {
+                assert!(
+                    (g[c] - q[c]).abs() <= 0.01 * m + 1e-30,
+                    "bin {bin}: exr {g:?} hdr {q:?}"
+                );
+            }
+        }
+    }
+}

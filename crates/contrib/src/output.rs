@@ -450,6 +450,18 @@ enum Dest {
     Stdout(std::io::BufWriter<std::io::Stdout>),
     File(PartialFile),
     Cmd(Child, std::io::BufWriter<ChildStdin>, String),
+    /// A picture (`-ffc` with `-x -y`) to a file named `*.exr`: pixels kept, written as
+    /// OpenEXR at the end (unrounded floats instead of RGBE).
+    Exr(ExrOut),
+}
+
+/// A picture collected for OpenEXR output.
+struct ExrOut {
+    path: String,
+    width: usize,
+    height: usize,
+    pixels: Vec<[f32; 3]>,
+    command: String,
 }
 
 /// An open stream.
@@ -511,7 +523,23 @@ impl Stream {
                             .with_context(|| format!("cannot create folder '{}'", dir.display()))?;
                     }
                 }
-                Dest::File(PartialFile::create(n)?)
+                if fenestra_formats::exr::is_exr_path(n) {
+                    if info.format != Format::Rgbe || info.xres == 0 || info.yres == 0 {
+                        bail!("'{n}': OpenEXR output needs picture output (-ffc with -x and -y)");
+                    }
+                    if plan.items.len() != 1 {
+                        bail!("'{n}': OpenEXR output holds one bin per file (use %d in -o)");
+                    }
+                    Dest::Exr(ExrOut {
+                        path: n.clone(),
+                        width: info.xres,
+                        height: info.yres,
+                        pixels: Vec::with_capacity(info.xres * info.yres),
+                        command: info.command.clone(),
+                    })
+                } else {
+                    Dest::File(PartialFile::create(n)?)
+                }
             }
         };
         let mut s = Stream {
@@ -534,6 +562,9 @@ impl Stream {
             .name
             .clone()
             .context("cannot recover the standard output")?;
+        if fenestra_formats::exr::is_exr_path(&name) {
+            bail!("'{name}': OpenEXR outputs cannot be recovered with -r (run again with -fo)");
+        }
         if part.complete {
             std::fs::rename(&name, partial_path(&name))
                 .with_context(|| format!("cannot reopen '{name}' to recover"))?;
@@ -552,10 +583,15 @@ impl Stream {
             Dest::Stdout(w) => w,
             Dest::File(f) => f,
             Dest::Cmd(_, w, _) => w,
+            Dest::Exr(_) => unreachable!("OpenEXR output is not a byte stream"),
         }
     }
 
     fn flush_buf(&mut self) -> Result<()> {
+        if matches!(self.dest, Dest::Exr(_)) {
+            self.buf.clear();
+            return Ok(());
+        }
         let buf = std::mem::take(&mut self.buf);
         let name = self
             .plan
@@ -604,6 +640,10 @@ impl Stream {
                     }
                 }
                 Format::Rgbe => {
+                    if let Dest::Exr(e) = &mut self.dest {
+                        e.pixels.push([v[0] as f32, v[1] as f32, v[2] as f32]);
+                        continue;
+                    }
                     let p = fenestra_formats::rgbe::encode_f64(v);
                     self.buf.extend_from_slice(&p);
                 }
@@ -624,6 +664,28 @@ impl Stream {
         match self.dest {
             Dest::Stdout(mut w) => w.flush()?,
             Dest::File(f) => f.commit()?,
+            Dest::Exr(e) => {
+                if e.pixels.len() != e.width * e.height {
+                    bail!(
+                        "'{}': {} pixels for a {} x {} picture",
+                        e.path,
+                        e.pixels.len(),
+                        e.width,
+                        e.height
+                    );
+                }
+                let head = fenestra_formats::picture::PictureHeader {
+                    command: Some(e.command),
+                    ..Default::default()
+                };
+                fenestra_formats::exr::write_picture_file(
+                    &e.path,
+                    Some(&head),
+                    e.width,
+                    e.height,
+                    &e.pixels,
+                )?;
+            }
             Dest::Cmd(mut child, mut w, cmd) => {
                 w.flush()
                     .with_context(|| format!("write error on output command '{cmd}'"))?;
