@@ -230,6 +230,9 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         } else {
             let name = &a[1..];
             match name {
+                n if fenestra_trace::TraceOptions::is_number_option(n) => {
+                    o.set_number(n, num(&args, i + 1)?);
+                }
                 "n" => {
                     let n = num(&args, i + 1)?;
                     if n < 1.0 {
@@ -290,17 +293,6 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                         )?;
                     }
                 }
-                "ab" => o.ab = num(&args, i + 1)?.max(0.0) as u32,
-                "ad" => o.ad = num(&args, i + 1)?.max(1.0) as u32,
-                "lw" => o.lw = num(&args, i + 1)?,
-                "lr" => o.lr = num(&args, i + 1)? as i32,
-                "ds" => o.ds = num(&args, i + 1)?,
-                "dj" => o.dj = num(&args, i + 1)?,
-                "dc" => o.dc = num(&args, i + 1)?,
-                "dr" => o.dr = num(&args, i + 1)? as i32,
-                "st" => o.st = num(&args, i + 1)?,
-                "ss" => o.ss = num(&args, i + 1)?,
-                "seed" => o.seed = num(&args, i + 1)? as u64,
                 "dt" | "dp" | "aa" | "ar" | "as" | "aw" | "mg" | "ms" => {
                     // -dt, -as and -aa are forced to 0 by rcontrib; the others do not apply.
                     num(&args, i + 1)?;

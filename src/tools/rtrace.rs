@@ -92,18 +92,11 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         } else {
             let name = &a[1..];
             match name {
-                "ab" => o.ab = num(&args, i + 1)?.max(0.0) as u32,
-                "ad" => o.ad = num(&args, i + 1)?.max(1.0) as u32,
-                "lw" => o.lw = num(&args, i + 1)?,
-                "lr" => o.lr = num(&args, i + 1)? as i32,
-                "ds" => o.ds = num(&args, i + 1)?,
-                "dj" => o.dj = num(&args, i + 1)?,
-                "dc" => o.dc = num(&args, i + 1)?,
-                "dr" => o.dr = num(&args, i + 1)? as i32,
+                n if fenestra_trace::TraceOptions::is_number_option(n) => {
+                    o.set_number(n, num(&args, i + 1)?);
+                }
                 "dt" => o.dt = num(&args, i + 1)?,
                 "dp" => {}
-                "st" => o.st = num(&args, i + 1)?,
-                "ss" => o.ss = num(&args, i + 1)?,
                 "aa" => aa = num(&args, i + 1)?,
                 "ar" | "as" | "aw" => {
                     num(&args, i + 1)?;
@@ -115,7 +108,6 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 "x" => xres = num(&args, i + 1)?.max(0.0) as usize,
                 "y" => yres = num(&args, i + 1)?.max(0.0) as usize,
                 "n" => nproc = num(&args, i + 1)?.max(1.0) as usize,
-                "seed" => o.seed = num(&args, i + 1)? as u64,
                 "av" => {
                     o.av = [num(&args, i + 1)?, num(&args, i + 2)?, num(&args, i + 3)?];
                     i += 2;

@@ -98,6 +98,38 @@ impl TraceOptions {
     }
 }
 
+impl TraceOptions {
+    /// The one-number integrator options both rtrace and rcontrib take, by Radiance name.
+    pub const NUMBER_OPTIONS: [&'static str; 11] = [
+        "ab", "ad", "lw", "lr", "ds", "dj", "dc", "dr", "st", "ss", "seed",
+    ];
+
+    /// Whether `name` is one of [`Self::NUMBER_OPTIONS`].
+    pub fn is_number_option(name: &str) -> bool {
+        Self::NUMBER_OPTIONS.contains(&name)
+    }
+
+    /// Sets one of [`Self::NUMBER_OPTIONS`] from its value (`-ab` at least 0, `-ad` at
+    /// least 1, integers truncated as Radiance's `atoi`); false for any other name.
+    pub fn set_number(&mut self, name: &str, v: f64) -> bool {
+        match name {
+            "ab" => self.ab = v.max(0.0) as u32,
+            "ad" => self.ad = v.max(1.0) as u32,
+            "lw" => self.lw = v,
+            "lr" => self.lr = v as i32,
+            "ds" => self.ds = v,
+            "dj" => self.dj = v,
+            "dc" => self.dc = v,
+            "dr" => self.dr = v as i32,
+            "st" => self.st = v,
+            "ss" => self.ss = v,
+            "seed" => self.seed = v as u64,
+            _ => return false,
+        }
+        true
+    }
+}
+
 impl Default for TraceOptions {
     fn default() -> Self {
         Self::rtrace()
