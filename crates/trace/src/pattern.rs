@@ -37,27 +37,64 @@ const HOST_VARS: [&str; 28] = [
     "RdotP", "S", "Ix", "Iy", "Iz", "Jx", "Jy", "Jz", "Kx", "Ky", "Kz", "Tx", "Ty",
 ];
 
-/// Evaluation states kept for reuse, so a pattern evaluation allocates nothing once
-/// each thread has made its first one.
-#[derive(Default)]
-struct StatePool(std::sync::Mutex<Vec<fenestra_calc::State>>);
+/// A trial ray evaluated when a pattern is compiled, so undefined names and wrong
+/// argument counts are reported at load time instead of as silent zeros later.
+const TRIAL: PatternInput = PatternInput {
+    dir: DVec3::new(0.3, 0.4, 0.866_025_403_784_438_6),
+    point: DVec3::ZERO,
+    normal: DVec3::new(0.0, 0.0, -1.0),
+    dist: 1.0,
+};
 
-impl StatePool {
-    fn with<R>(&self, exe: &Compiled, f: impl FnOnce(&mut fenestra_calc::State) -> R) -> R {
-        let taken = self.0.lock().map(|mut v| v.pop()).unwrap_or(None);
-        let mut st = taken.unwrap_or_else(|| exe.state());
-        let r = f(&mut st);
-        if let Ok(mut v) = self.0.lock() {
-            v.push(st);
-        }
-        r
+/// A program with what every pattern sees first: `rayinit.cal`, then the command
+/// line's `-e`/`-f` sources, then the pattern's own file (`.` for none).
+fn program(user: &[CalSource], cal: &str) -> Result<Program> {
+    let mut p = Program::for_renderer();
+    let init = fenestra_cli::raypath::find_or_err("rayinit.cal")?;
+    p.load_file(&init).map_err(|e| anyhow!("{e}"))?;
+    for c in user {
+        c.load(&mut p)?;
     }
+    if cal != "." {
+        let path = fenestra_cli::raypath::find_or_err(cal)?;
+        p.load_file(&path).map_err(|e| anyhow!("{e}"))?;
+    }
+    Ok(p)
+}
+
+/// Identifies a compiled pattern for the per-thread evaluation states.
+static NEXT_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+thread_local! {
+    /// Each thread's evaluation state per pattern (by id): a pattern evaluation takes no
+    /// lock and allocates nothing once its thread has made the state.
+    static STATES: std::cell::RefCell<Vec<(u64, fenestra_calc::State)>> =
+        const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// Runs `f` with this thread's evaluation state for pattern `id` of program `exe`.
+fn with_state<R>(id: u64, exe: &Compiled, f: impl FnOnce(&mut fenestra_calc::State) -> R) -> R {
+    STATES.with(|s| {
+        let mut s = s.borrow_mut();
+        let k = match s.iter().position(|e| e.0 == id) {
+            Some(k) => k,
+            None => {
+                // States of patterns from earlier scenes are dropped now and then.
+                if s.len() >= 64 {
+                    s.clear();
+                }
+                s.push((id, exe.state()));
+                s.len() - 1
+            }
+        };
+        f(&mut s[k].1)
+    })
 }
 
 /// A pattern compiled from a .cal file.
 pub struct CalPattern {
     exe: Compiled,
-    pool: StatePool,
+    id: u64,
     vars: Vec<VarId>,
     exprs: Vec<ExprId>,
     fargs: Vec<f64>,
@@ -83,16 +120,7 @@ impl CalPattern {
         label: &str,
         user: &[CalSource],
     ) -> Result<CalPattern> {
-        let mut p = Program::for_renderer();
-        let init = fenestra_cli::raypath::find_or_err("rayinit.cal")?;
-        p.load_file(&init).map_err(|e| anyhow!("{e}"))?;
-        for c in user {
-            c.load(&mut p)?;
-        }
-        if cal != "." {
-            let path = fenestra_cli::raypath::find_or_err(cal)?;
-            p.load_file(&path).map_err(|e| anyhow!("{e}"))?;
-        }
+        let mut p = program(user, cal)?;
         let vars = p.bind_vars(&HOST_VARS);
         let mut ids = Vec::new();
         for e in exprs {
@@ -101,18 +129,12 @@ impl CalPattern {
         let exe = p.compile().map_err(|e| anyhow!("{e}"))?;
         let cp = CalPattern {
             exe,
-            pool: StatePool::default(),
+            id: NEXT_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
             vars,
             exprs: ids,
             fargs: fargs.to_vec(),
         };
-        let trial = PatternInput {
-            dir: DVec3::new(0.3, 0.4, 0.866_025_403_784_438_6),
-            point: DVec3::ZERO,
-            normal: DVec3::new(0.0, 0.0, -1.0),
-            dist: 1.0,
-        };
-        cp.eval(&trial)?;
+        cp.eval(&TRIAL)?;
         Ok(cp)
     }
 
@@ -131,7 +153,7 @@ impl CalPattern {
     }
 
     fn eval(&self, q: &PatternInput) -> Result<DVec3> {
-        self.pool.with(&self.exe, |st| {
+        with_state(self.id, &self.exe, |st| {
             st.set_all(&self.vars, &Self::values(q));
             st.set_fargs(&self.fargs);
             let mut out = [0.0; 3];
@@ -164,7 +186,7 @@ pub enum Pattern {
 /// values (brightdata: `func(v)`; colordata: `rfunc(r,g,b)`, `gfunc(…)`, `bfunc(…)`).
 pub struct DataPattern {
     exe: Compiled,
-    pool: StatePool,
+    id: u64,
     vars: Vec<VarId>,
     coords: Vec<ExprId>,
     funcs: Vec<FuncId>,
@@ -183,7 +205,7 @@ impl std::fmt::Debug for DataPattern {
 
 impl DataPattern {
     fn eval(&self, q: &PatternInput) -> Result<DVec3> {
-        self.pool.with(&self.exe, |st| {
+        with_state(self.id, &self.exe, |st| {
             st.set_all(&self.vars, &CalPattern::values(q));
             st.set_fargs(&self.fargs);
             let mut x = [0.0f64; 16];
@@ -292,17 +314,7 @@ fn compile_data(q: &fenestra_scene::Primitive, what: &str, user: &[CalSource]) -
     if coords.len() > dims {
         bail!("{what}: transform arguments on patterns are not supported yet");
     }
-    let mut p = Program::for_renderer();
-    let init =
-        fenestra_cli::raypath::find_or_err("rayinit.cal").map_err(|e| anyhow!("{what}: {e:#}"))?;
-    p.load_file(&init).map_err(|e| anyhow!("{what}: {e}"))?;
-    for c in user {
-        c.load(&mut p).map_err(|e| anyhow!("{what}: {e:#}"))?;
-    }
-    if cal != "." {
-        let path = fenestra_cli::raypath::find_or_err(cal).map_err(|e| anyhow!("{what}: {e:#}"))?;
-        p.load_file(&path).map_err(|e| anyhow!("{what}: {e}"))?;
-    }
+    let mut p = program(user, cal).map_err(|e| anyhow!("{what}: {e:#}"))?;
     let vars = p.bind_vars(&HOST_VARS);
     let mut ids = Vec::new();
     for e in coords {
@@ -317,19 +329,13 @@ fn compile_data(q: &fenestra_scene::Primitive, what: &str, user: &[CalSource]) -
     }
     let dp = DataPattern {
         exe,
-        pool: StatePool::default(),
+        id: NEXT_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
         vars,
         coords: ids,
         funcs,
         grids,
         fargs: q.rargs.clone(),
     };
-    let trial = PatternInput {
-        dir: DVec3::new(0.3, 0.4, 0.866_025_403_784_438_6),
-        point: DVec3::ZERO,
-        normal: DVec3::new(0.0, 0.0, -1.0),
-        dist: 1.0,
-    };
-    dp.eval(&trial).map_err(|e| anyhow!("{what}: {e}"))?;
+    dp.eval(&TRIAL).map_err(|e| anyhow!("{what}: {e}"))?;
     Ok(Pattern::Data(Arc::new(dp)))
 }
