@@ -301,13 +301,7 @@ fn parse_res(w: &str, axis: &str, sources: &[Source], xmax: usize, ymax: usize) 
     p.set_number("ymax", ymax as f64);
     p.set_number("PI", std::f64::consts::PI);
     for s in sources {
-        match s {
-            Source::Expr(e) => p.load_str("-e", e).map_err(|e| anyhow::anyhow!("{e}"))?,
-            Source::File(f) => {
-                let path = fenestra_cli::raypath::find_or_err(f)?;
-                p.load_file(&path).map_err(|e| anyhow::anyhow!("{e}"))?;
-            }
-        }
+        s.load(&mut p)?;
     }
     let e = p
         .add_expr(&format!("-{axis}"), w)

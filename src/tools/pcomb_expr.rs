@@ -25,6 +25,16 @@ pub struct ExprInput {
     pub aspect: f64,
 }
 
+impl ExprInput {
+    fn exposure_of(&self) -> f64 {
+        self.exposure
+    }
+
+    fn aspect_of(&self) -> f64 {
+        self.aspect
+    }
+}
+
 thread_local! {
     /// The output pixel being computed (x, y from the bottom) and the output size.
     static PIXEL: Cell<(f64, f64, f64, f64)> = const { Cell::new((0.0, 0.0, 1.0, 1.0)) };
@@ -39,13 +49,8 @@ pub struct Exprs {
     lo: Option<VarId>,
 }
 
-/// A command-line source: `-e` text or `-f` file.
-pub enum Source {
-    /// `-e expr`.
-    Expr(String),
-    /// `-f file`.
-    File(String),
-}
+/// A command-line source: `-e` text or `-f` file (the renderers' type, loaded the same way).
+pub use fenestra_trace::options::CalSource as Source;
 
 /// Radiance's luminance weights (`bright()`).
 const LUM: [f64; 3] = [0.265_074_126, 0.670_114_631, 0.064_811_243];
@@ -106,38 +111,25 @@ impl Exprs {
                 Arc::new(move |a: &[f64]| input_value(&inp, a, chan)),
             );
         }
-        let inp = inputs.clone();
-        p.define_host_fn(
-            "le",
-            1,
-            Arc::new(move |a: &[f64]| {
-                let k = (a[0] + 0.5).floor();
-                if k <= 0.0 {
-                    return inp.len() as f64;
-                }
-                inp.get(k as usize - 1).map_or(0.0, |i| i.exposure)
-            }),
-        );
-        let inp = inputs.clone();
-        p.define_host_fn(
-            "pa",
-            1,
-            Arc::new(move |a: &[f64]| {
-                let k = (a[0] + 0.5).floor();
-                if k <= 0.0 {
-                    return inp.len() as f64;
-                }
-                inp.get(k as usize - 1).map_or(0.0, |i| i.aspect)
-            }),
-        );
+        for (name, field) in [
+            ("le", ExprInput::exposure_of as fn(&ExprInput) -> f64),
+            ("pa", ExprInput::aspect_of),
+        ] {
+            let inp = inputs.clone();
+            p.define_host_fn(
+                name,
+                1,
+                Arc::new(move |a: &[f64]| {
+                    let k = (a[0] + 0.5).floor();
+                    if k <= 0.0 {
+                        return inp.len() as f64;
+                    }
+                    inp.get(k as usize - 1).map_or(0.0, field)
+                }),
+            );
+        }
         for s in sources {
-            match s {
-                Source::Expr(e) => p.load_str("-e", e).map_err(|e| anyhow!("{e}"))?,
-                Source::File(f) => {
-                    let path = fenestra_cli::raypath::find_or_err(f)?;
-                    p.load_file(&path).map_err(|e| anyhow!("{e}"))?;
-                }
-            }
+            s.load(&mut p)?;
         }
         let xy = p.bind_vars(&["x", "y"]);
         let exe = p.compile().map_err(|e| anyhow!("{e}"))?;
