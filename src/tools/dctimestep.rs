@@ -143,10 +143,18 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         Some((t, d)) => Some(load_td(t, d)?),
         None => None,
     };
+    // The two-phase form learns the sky's size from the left matrix: open it once here
+    // and keep the reader (a `-` or `!command` input can be read only once).
+    let mut v_reader = None;
     let sky_rows = match &td {
         Some((td, _)) => td.cols,
         None if picture => 0, // learnt from the sky itself
-        None => MatrixReader::open(&vspec)?.info.ncols,
+        None => {
+            let r = MatrixReader::open(&vspec)?;
+            let n = r.info.ncols;
+            v_reader = Some(r);
+            n
+        }
     };
     let sky = read_sky(
         &sky_spec,
@@ -166,7 +174,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         return picture_form(&vspec, td.map(|t| t.0), &sky, &o);
     }
     let td = td.map(|t| t.0);
-    matrix_form(&vspec, td.as_ref(), td_specs.as_ref(), &sky, &o)?;
+    matrix_form(v_reader, &vspec, td.as_ref(), td_specs.as_ref(), &sky, &o)?;
     Ok(ExitCode::SUCCESS)
 }
 
@@ -514,7 +522,6 @@ fn stdout_offset() -> Option<u64> {
 struct Sink {
     fmt: DataFormat,
     ocols: usize,
-    index: usize,
     scan: Vec<[u8; 4]>,
 }
 
@@ -523,7 +530,6 @@ impl Sink {
         Sink {
             fmt,
             ocols,
-            index: 0,
             scan: Vec::with_capacity(ocols),
         }
     }
@@ -578,7 +584,7 @@ impl Sink {
     }
 
     /// Writes encoded bytes of `n` elements.
-    fn put(&mut self, w: &mut dyn Write, bytes: &[u8], n: usize) -> Result<()> {
+    fn put(&mut self, w: &mut dyn Write, bytes: &[u8]) -> Result<()> {
         if self.fmt.is_picture() {
             for p in bytes.chunks_exact(4) {
                 self.scan.push([p[0], p[1], p[2], p[3]]);
@@ -590,7 +596,6 @@ impl Sink {
         } else {
             w.write_all(bytes)?;
         }
-        self.index += n;
         Ok(())
     }
 }
@@ -646,13 +651,17 @@ impl VRows {
 
 /// `V·(T·D)·S` (or `DC·S`) with V streamed in blocks of rows.
 fn matrix_form(
+    opened: Option<MatrixReader>,
     vname: &str,
     td: Option<&Planar>,
     td_names: Option<&(String, String)>,
     sky: &PackedSky,
     o: &Opts,
 ) -> Result<()> {
-    let vr = MatrixReader::open(vname)?;
+    let vr = match opened {
+        Some(r) => r,
+        None => MatrixReader::open(vname)?,
+    };
     let need = td.map(|m| m.rows).unwrap_or(sky.patches());
     if vr.info.ncols != need {
         match td_names {
@@ -724,7 +733,7 @@ fn matrix_form(
                         .map(|r| [res.get(r, t, 0), res.get(r, t, 1), res.get(r, t, 2)])
                         .collect();
                     let bytes = Sink::encode(o.out_fmt, ocols, 0, &vals);
-                    sink.put(dest.w(), &bytes, vals.len())?;
+                    sink.put(dest.w(), &bytes)?;
                     dest.finish().with_context(|| format!("writing {name}"))
                 })?;
             p = p1;
@@ -766,7 +775,7 @@ fn matrix_form(
             .map(|(r, vals)| Sink::encode(o.out_fmt, ocols, (done + r) * steps, vals))
             .collect();
         for e in &encoded {
-            sink.put(dest.w(), e, steps)?;
+            sink.put(dest.w(), e)?;
         }
         done += n;
     }
@@ -851,23 +860,20 @@ fn picture_form(vspec: &str, td: Option<Planar>, sky: &PackedSky, o: &Opts) -> R
         }
         let (w, h) = (res.scanlen(), res.numscans());
         // -x/-y do not apply to the picture form (Radiance ignores them there too).
-        let (oh, ow) = (h, w);
         let frame = (steps > 1).then_some(t);
         let mut hb = if per_step.is_none() && t > 0 && o.header {
             // Later frames in one stream: Radiance writes only FRAME, FORMAT and the resolution.
             let mut b = format!("FRAME={t}\nFORMAT=32-bit_rle_rgbe\n\n").into_bytes();
-            b.extend_from_slice(Resolution::standard(ow, oh).to_string().as_bytes());
+            b.extend_from_slice(Resolution::standard(w, h).to_string().as_bytes());
             b
         } else {
-            header_bytes(o, frame, oh, ow, None)
+            header_bytes(o, frame, h, w, None)
         };
-        if (oh, ow) == (h, w) {
-            // Keep the pictures' own orientation.
-            let std = Resolution::standard(w, h).to_string();
-            if hb.ends_with(std.as_bytes()) {
-                hb.truncate(hb.len() - std.len());
-                hb.extend_from_slice(res.to_string().as_bytes());
-            }
+        // Keep the pictures' own orientation.
+        let std = Resolution::standard(w, h).to_string();
+        if hb.ends_with(std.as_bytes()) {
+            hb.truncate(hb.len() - std.len());
+            hb.extend_from_slice(res.to_string().as_bytes());
         }
         // A picture file named *.exr is written as OpenEXR (one file per time step).
         let exr_name = match (&per_step, o.out_spec.as_deref()) {
@@ -891,14 +897,14 @@ fn picture_form(vspec: &str, td: Option<Planar>, sky: &PackedSky, o: &Opts) -> R
             fenestra_formats::exr::write_picture_file(&name, Some(&head), w, h, &px)?;
             continue;
         }
-        let enc = Sink::encode(DataFormat::Rgbe, ow, 0, &sum);
+        let enc = Sink::encode(DataFormat::Rgbe, w, 0, &sum);
         match &per_step {
             Some(p) => {
                 let name = format_int_field(p, t);
                 let (mut d, _) = Dest::open(Some(&name))?;
                 d.w().write_all(&hb)?;
-                let mut sink = Sink::new(DataFormat::Rgbe, ow);
-                sink.put(d.w(), &enc, sum.len())?;
+                let mut sink = Sink::new(DataFormat::Rgbe, w);
+                sink.put(d.w(), &enc)?;
                 d.finish()?;
             }
             None => {
@@ -908,8 +914,8 @@ fn picture_form(vspec: &str, td: Option<Planar>, sky: &PackedSky, o: &Opts) -> R
                 }
                 let (d, _) = stdout_dest.as_mut().expect("destination");
                 d.w().write_all(&hb)?;
-                let mut sink = Sink::new(DataFormat::Rgbe, ow);
-                sink.put(d.w(), &enc, sum.len())?;
+                let mut sink = Sink::new(DataFormat::Rgbe, w);
+                sink.put(d.w(), &enc)?;
             }
         }
         if cache.iter().flatten().count() * sum.len() * 12 > (1 << 30) {
