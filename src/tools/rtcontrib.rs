@@ -436,7 +436,6 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             count: if count == 0 { 256 } else { count },
             errors,
             batches,
-            nproc,
         };
         let probe = Engine::new(&tracer, &bins, scene.prims.len(), &tracked, probe_opts);
         let c = if count == 0 { 256 } else { count };
@@ -570,7 +569,6 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         count,
         errors,
         batches,
-        nproc,
     };
     let engine = Engine::new(&tracer, &bins, scene.prims.len(), &tracked, opts);
     let progress = fenestra_cli::progress::Progress::new(rays.len() as u64, fenestra_cli::prog());

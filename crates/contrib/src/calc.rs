@@ -300,11 +300,6 @@ impl Bins {
         self.groups.iter().map(|(c, _)| c.state()).collect()
     }
 
-    /// Whether modifier `m`'s bin expression is evaluated natively.
-    pub fn is_native(&self, m: usize) -> bool {
-        self.natives[m].is_some()
-    }
-
     /// The bin value of modifier `m` for a contribution (not yet rounded).
     pub fn eval_for(
         &self,

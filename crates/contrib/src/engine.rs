@@ -33,8 +33,7 @@ pub struct InputRay {
 }
 
 /// Reads rays until the input ends, a word is not a number, or `limit` rays were read.
-/// A partial final ray is dropped. Returns the rays and whether the input ended early
-/// inside a ray (for warnings).
+/// A partial final ray is dropped.
 pub fn read_rays(
     rd: &mut dyn BufRead,
     fmt: InFormat,
@@ -137,8 +136,6 @@ pub struct RunOptions {
     pub errors: bool,
     /// With `-c 1` and errors: independent batches per ray (the value is their mean).
     pub batches: usize,
-    /// Threads.
-    pub nproc: usize,
 }
 
 /// One output record: values and (when asked) standard errors, `3 × total bins` each.
@@ -148,7 +145,7 @@ pub struct Record {
     pub sums: Vec<f64>,
     /// 1/N for an average of N rays, 1 for a sum.
     pub scale: f64,
-    /// Standard errors of `values`.
+    /// Standard errors of the values (`sums × scale`), with `-E`.
     pub errors: Option<Vec<f64>>,
 }
 
@@ -207,11 +204,6 @@ impl<'a> Engine<'a> {
             bad: Mutex::new(BTreeSet::new()),
             fail: Mutex::new(None),
         }
-    }
-
-    /// Number of values (RGB triplets) in a record.
-    pub fn total_bins(&self) -> usize {
-        self.total
     }
 
     /// Index of modifier `m`, bin `b` in a record's values (times 3 for RGB).

@@ -286,16 +286,6 @@ impl KlemsSampler {
         let o = self.point(u1, u2, u3) + self.offset * self.vd;
         (o, d)
     }
-
-    /// The frame vectors `(vd, vh, vv)`.
-    pub fn frame(&self) -> (DVec3, DVec3, DVec3) {
-        (self.vd, self.vh, self.vv)
-    }
-
-    /// The aperture.
-    pub fn aperture(&self) -> &Aperture {
-        &self.aperture
-    }
 }
 
 #[cfg(test)]
