@@ -459,7 +459,7 @@ impl Dest {
     fn open(name: Option<&str>) -> Result<(Dest, Option<u64>)> {
         match name {
             None => {
-                let off = stdout_offset();
+                let off = fenestra_cli::output::stdout_file_offset();
                 Ok((
                     Dest::Stdout(BufWriter::with_capacity(1 << 20, std::io::stdout())),
                     off,
@@ -493,27 +493,6 @@ impl Dest {
                 f.commit()
             }
         }
-    }
-}
-
-/// The current offset of standard output when it is a seekable file (Radiance pads
-/// binary headers then), `None` for pipes and terminals.
-fn stdout_offset() -> Option<u64> {
-    #[cfg(unix)]
-    {
-        use std::io::Seek;
-        use std::os::fd::AsFd;
-        let fd = std::io::stdout().as_fd().try_clone_to_owned().ok()?;
-        let mut f = std::fs::File::from(fd);
-        let meta = f.metadata().ok()?;
-        if !meta.is_file() {
-            return None;
-        }
-        f.stream_position().ok()
-    }
-    #[cfg(not(unix))]
-    {
-        None
     }
 }
 

@@ -305,7 +305,7 @@ fn output_options(p: &Parsed, m: &Mtx, args: &[String]) -> Result<WriteOptions> 
         format,
         ascii: AsciiLayout::Rmtxop,
         header: Some(h),
-        align_from: stdout_file_offset(),
+        align_from: fenestra_cli::output::stdout_file_offset(),
         ..Default::default()
     })
 }
@@ -341,23 +341,4 @@ fn reduce_chain(chain: Vec<(Mtx, String)>, verbose: bool) -> Result<Mtx> {
         return multiply_chain(mats).with_context(|| format!("{last}: matrix product failed"));
     }
     mats.into_iter().next().context("no input matrix")
-}
-
-/// The current offset of the standard output when it is a regular file (Radiance pads
-/// binary headers so data start aligned in files, not in pipes).
-#[cfg(unix)]
-fn stdout_file_offset() -> Option<u64> {
-    use std::io::Seek;
-    use std::os::fd::AsFd;
-    let fd = std::io::stdout().as_fd().try_clone_to_owned().ok()?;
-    let mut f = std::fs::File::from(fd);
-    if !f.metadata().ok()?.is_file() {
-        return None;
-    }
-    f.stream_position().ok()
-}
-
-#[cfg(not(unix))]
-fn stdout_file_offset() -> Option<u64> {
-    None
 }

@@ -83,6 +83,26 @@ impl Drop for AtomicFile {
     }
 }
 
+/// Where standard output stands when it is a regular file (Radiance pads binary headers
+/// so the data start aligned in files, not in pipes); `None` for pipes and terminals.
+pub fn stdout_file_offset() -> Option<u64> {
+    #[cfg(unix)]
+    {
+        use std::io::Seek;
+        use std::os::fd::AsFd;
+        let fd = std::io::stdout().as_fd().try_clone_to_owned().ok()?;
+        let mut f = std::fs::File::from(fd);
+        if !f.metadata().ok()?.is_file() {
+            return None;
+        }
+        f.stream_position().ok()
+    }
+    #[cfg(not(unix))]
+    {
+        None
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
