@@ -4,31 +4,15 @@
 
 mod common;
 
-use std::io::Write;
 use std::path::Path;
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Output};
 
 fn fx(name: &str) -> String {
     common::fixture("rcontrib").join(name).display().to_string()
 }
 
-fn run_in(mut cmd: Command, input: &[u8]) -> Output {
-    let mut child = cmd
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("spawn");
-    let mut stdin = child.stdin.take().unwrap();
-    // written from a thread: the tool writes output while it reads (a full pipe both ways
-    // would block), and it may refuse its options before reading any input
-    let data = input.to_vec();
-    let writer = std::thread::spawn(move || {
-        let _ = stdin.write_all(&data);
-    });
-    let out = child.wait_with_output().unwrap();
-    let _ = writer.join();
-    out
+fn run_in(cmd: Command, input: &[u8]) -> Output {
+    common::run_stdin(cmd, input)
 }
 
 fn ok(cmd: Command, input: &[u8]) -> Vec<u8> {
@@ -48,10 +32,7 @@ fn rc(args: &[&str]) -> Command {
 }
 
 fn nums(text: &[u8]) -> Vec<f64> {
-    String::from_utf8_lossy(text)
-        .split_whitespace()
-        .map(|w| w.parse().unwrap())
-        .collect()
+    common::numbers(text)
 }
 
 fn data_part(text: &[u8]) -> &[u8] {
