@@ -90,13 +90,9 @@ impl Program {
         let bad = crate::fold::fold(&mut out);
         if let Some(&i) = bad.first() {
             if !self.no_parse_constants {
-                let what = out
-                    .var_names
-                    .get(i)
-                    .map_or(String::new(), |n| format!("{n}: "));
                 return Err(CalcError::new(
                     ErrorKind::Syntax,
-                    format!("{what}bad constant expression"),
+                    format!("{}: bad constant expression", out.var_names[i]),
                 ));
             }
         }

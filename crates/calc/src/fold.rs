@@ -18,8 +18,6 @@ enum Mark {
 struct Purity {
     vars: Vec<Mark>,
     funcs: Vec<Mark>,
-    /// Constant sub-expressions whose evaluation raised an error.
-    bad: usize,
 }
 
 impl Purity {
@@ -191,7 +189,6 @@ pub(crate) fn fold(c: &mut Compiled) -> Vec<usize> {
     let mut p = Purity {
         vars: vec![Mark::Unknown; c.vars.len()],
         funcs: vec![Mark::Unknown; c.funcs.len()],
-        bad: 0,
     };
     // 1. pure variables become constants
     for i in 0..c.vars.len() {
@@ -230,9 +227,6 @@ pub(crate) fn fold(c: &mut Compiled) -> Vec<usize> {
         let mut node = c.exprs[k].clone();
         fold_node(c, &mut p, &mut node, false);
         c.exprs[k] = node;
-    }
-    if p.bad > 0 && bad.is_empty() {
-        bad.push(usize::MAX);
     }
     bad
 }
