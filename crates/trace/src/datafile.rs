@@ -39,11 +39,14 @@ impl Axis {
             }
             Axis::Listed(v) => {
                 let up = v[n - 1] >= v[0];
-                // first k with x before v[k+1] (in the axis direction)
-                let mut k = 0;
-                while k < n - 2 && (if up { x >= v[k + 1] } else { x <= v[k + 1] }) {
-                    k += 1;
-                }
+                // the interval [v[k], v[k+1]] holding x (end intervals extend outward);
+                // v is monotonic, so a binary search finds it
+                let inner = &v[1..n - 1];
+                let k = if up {
+                    inner.partition_point(|&c| x >= c)
+                } else {
+                    inner.partition_point(|&c| x <= c)
+                };
                 let d = v[k + 1] - v[k];
                 (k, if d == 0.0 { 0.0 } else { (x - v[k]) / d })
             }
@@ -184,6 +187,17 @@ mod tests {
         assert!((g.value(&[0.0, 20.0]) - 6.0).abs() < 1e-12);
         // linear extension beyond the last row
         assert!((g.value(&[-0.5, 10.0]) - 7.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn listed_axes_find_their_interval_either_way() {
+        // values equal to the coordinate times 10: interpolation and extension are exact
+        let up = DataGrid::parse("1\n0 0 4 0 1 3 6\n0 10 30 60\n", "t").unwrap();
+        let down = DataGrid::parse("1\n0 0 4 6 3 1 0\n60 30 10 0\n", "t").unwrap();
+        for x in [-1.0, 0.0, 0.5, 1.0, 2.0, 3.0, 4.5, 6.0, 7.0] {
+            assert!((up.value(&[x]) - 10.0 * x).abs() < 1e-12, "up {x}");
+            assert!((down.value(&[x]) - 10.0 * x).abs() < 1e-12, "down {x}");
+        }
     }
 
     #[test]
