@@ -533,8 +533,7 @@ impl State {
                 if !self.warned.iter().any(|k| k == other) {
                     self.warned.push(other.to_string());
                     eprintln!(
-                        "{}: warning - {}: unknown MGF entity '{other}' skipped",
-                        fenestra_cli_prog(),
+                        "mgf: warning - {}: unknown MGF entity '{other}' skipped",
                         l.loc
                     );
                 }
@@ -902,10 +901,6 @@ impl State {
         let b: Vec<[f64; 3]> = base.iter().map(|p| xf.point(*p)).collect();
         self.polygon(l, xf, b, "f")
     }
-}
-
-fn fenestra_cli_prog() -> &'static str {
-    "mgf"
 }
 
 /// Index of the bare `xf` closing the `xf` at `start`.
