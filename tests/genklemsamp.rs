@@ -44,7 +44,11 @@ fn rows(text: &[u8]) -> Vec<Vec<f64>> {
 
 fn pipe(cmd: Command, input: &[u8]) -> Vec<u8> {
     let out = common::run_stdin(cmd, input);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     out.stdout
 }
 
