@@ -25,6 +25,9 @@ pub(crate) enum VarSlot {
     Def(Node, bool),
     /// Folded to a constant.
     Const(f64),
+    /// An `=` variable folded to a constant whose evaluation makes library calls: its
+    /// first use in an evaluation leaves the error flag cleared, as evaluating it would.
+    ConstClr(f64),
 }
 
 /// A compiled user function.
@@ -119,6 +122,8 @@ pub struct State {
     warnings: Warnings,
     /// The error flag built-in calls check (see [`ErrFlag`]).
     errno: ErrFlag,
+    /// Counts writes of the error flag (to know whether an evaluation touched it).
+    errno_writes: u64,
 }
 
 pub(crate) struct Frame<'a> {
@@ -201,6 +206,17 @@ impl State {
         self.epoch += 1;
     }
 
+    #[inline]
+    fn set_errno(&mut self, e: ErrFlag) {
+        self.errno = e;
+        self.errno_writes += 1;
+    }
+
+    /// Whether the error flag was written since `writes` was read from `errno_writes`.
+    pub(crate) fn errno_written_since(&self, writes: u64) -> bool {
+        self.errno_writes != writes
+    }
+
     /// Returns and clears the warnings counted so far.
     pub fn take_warnings(&mut self) -> Warnings {
         std::mem::take(&mut self.warnings)
@@ -221,6 +237,7 @@ impl Compiled {
             fail: None,
             warnings: Warnings::default(),
             errno: ErrFlag::None,
+            errno_writes: 0,
         }
     }
 
@@ -253,7 +270,7 @@ impl Compiled {
     /// The value of a folded constant variable, if it is one.
     pub fn constant_value(&self, v: VarId) -> Option<f64> {
         match self.vars[v.0 as usize] {
-            VarSlot::Const(x) => Some(x),
+            VarSlot::Const(x) | VarSlot::ConstClr(x) => Some(x),
             _ => None,
         }
     }
@@ -324,6 +341,15 @@ impl Compiled {
         let iu = i as usize;
         match &self.vars[iu] {
             VarSlot::Const(x) => *x,
+            VarSlot::ConstClr(x) => {
+                // evaluated (its library calls made) once per evaluation, as Radiance
+                // caches `=` variables
+                if st.stamps[iu] != st.epoch {
+                    st.stamps[iu] = st.epoch;
+                    st.set_errno(ErrFlag::None);
+                }
+                *x
+            }
             VarSlot::Host => st.vals[iu],
             VarSlot::Def(node, constant) => {
                 let want = if *constant { u64::MAX } else { st.epoch };
@@ -439,7 +465,7 @@ impl Compiled {
         name: &'static str,
         f: impl FnOnce(&Self, &mut State) -> f64,
     ) -> f64 {
-        st.errno = ErrFlag::None;
+        st.set_errno(ErrFlag::None);
         let v = f(self, st);
         if st.errno != ErrFlag::None {
             self.lib_error(st, name)
@@ -494,7 +520,7 @@ impl Compiled {
                 let n = self.eval(&args[0], st, fr);
                 let count = args.len() - 1;
                 if n.is_nan() || n < -0.5 {
-                    st.errno = ErrFlag::Domain;
+                    st.set_errno(ErrFlag::Domain);
                     return 0.0;
                 }
                 if n + 0.5 >= 2147483648.0 {
@@ -510,7 +536,7 @@ impl Compiled {
                     return count as f64;
                 }
                 if i as usize > count {
-                    st.errno = ErrFlag::Domain;
+                    st.set_errno(ErrFlag::Domain);
                     return 0.0;
                 }
                 self.eval(&args[i as usize], st, fr)
@@ -569,6 +595,11 @@ impl Compiled {
     pub(crate) fn eval(&self, n: &Node, st: &mut State, fr: &Frame) -> f64 {
         match n {
             Node::Num(v) => *v,
+            Node::NumClr(v) => {
+                st.set_errno(ErrFlag::None);
+                *v
+            }
+            Node::Lib(name, a) => self.lib_call(st, name, |c, st| c.eval(a, st, fr)),
             Node::Var(i) => self.var_value(*i, st),
             Node::Chan(c) => st
                 .chans
@@ -586,7 +617,7 @@ impl Compiled {
                 let b = self.eval(&p.1, st, fr);
                 if b == 0.0 {
                     st.warnings.division_by_zero += 1;
-                    st.errno = ErrFlag::Range;
+                    st.set_errno(ErrFlag::Range);
                     0.0
                 } else {
                     a / b

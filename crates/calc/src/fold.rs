@@ -23,7 +23,8 @@ struct Purity {
 impl Purity {
     fn node(&mut self, c: &Compiled, n: &Node) -> bool {
         match n {
-            Node::Num(_) | Node::Param(_) | Node::FuncRef(_) => true,
+            Node::Num(_) | Node::NumClr(_) | Node::Param(_) | Node::FuncRef(_) => true,
+            Node::Lib(_, a) => self.node(c, a),
             Node::Chan(_) | Node::CallHost(..) | Node::CallParam(..) | Node::Fail(_) => false,
             Node::Var(i) => self.var(c, *i as usize),
             Node::Neg(a) | Node::Math1(_, a) => self.node(c, a),
@@ -49,7 +50,7 @@ impl Purity {
         }
         let pure = match &c.vars[i] {
             VarSlot::Host => false,
-            VarSlot::Const(_) => true,
+            VarSlot::Const(_) | VarSlot::ConstClr(_) => true,
             VarSlot::Def(n, _) => {
                 self.vars[i] = Mark::Busy;
                 self.node(c, n)
@@ -72,20 +73,21 @@ impl Purity {
     }
 }
 
-/// Evaluates a node that has no free parameters, if it does so cleanly.
-fn try_eval(c: &Compiled, n: &Node) -> Option<f64> {
+/// Evaluates a node that has no free parameters, if it does so cleanly; with whether
+/// the evaluation made library calls (wrote the error flag).
+fn try_eval(c: &Compiled, n: &Node) -> Option<(f64, bool)> {
     let mut st = c.state();
     let id = crate::eval::probe(c, n, &mut st)?;
     if st.take_warnings().any() {
         return None;
     }
-    Some(id)
+    Some((id, st.errno_written_since(0)))
 }
 
 fn fold_node(c: &Compiled, p: &mut Purity, n: &mut Node, in_func: bool) {
     // children first
     match n {
-        Node::Neg(a) | Node::Math1(_, a) => fold_node(c, p, a, in_func),
+        Node::Neg(a) | Node::Math1(_, a) | Node::Lib(_, a) => fold_node(c, p, a, in_func),
         Node::Add(q)
         | Node::Sub(q)
         | Node::Mul(q)
@@ -111,6 +113,7 @@ fn fold_node(c: &Compiled, p: &mut Purity, n: &mut Node, in_func: bool) {
         _ => {}
     }
     let foldable = match n {
+        // a `ConstClr` variable stays: only its first use clears the error flag
         Node::Var(i) => matches!(c.vars[*i as usize], VarSlot::Const(_)),
         Node::Neg(a) | Node::Math1(_, a) => a.num().is_some(),
         Node::Add(q)
@@ -139,7 +142,7 @@ fn fold_node(c: &Compiled, p: &mut Purity, n: &mut Node, in_func: bool) {
     if let Node::If(t) = n {
         let cond = t.0.num().unwrap_or(0.0);
         let chosen = if cond > 0.0 { t.1.clone() } else { t.2.clone() };
-        *n = chosen;
+        *n = lib_reduced("if", chosen);
         return;
     }
     if let Node::Builtin(Builtin::Select, args) = n {
@@ -148,9 +151,9 @@ fn fold_node(c: &Compiled, p: &mut Purity, n: &mut Node, in_func: bool) {
         if v >= -0.5 {
             let i = (v + 0.5) as i64 as usize;
             if i == 0 {
-                *n = Node::Num(count as f64);
+                *n = Node::NumClr(count as f64);
             } else if i <= count {
-                *n = args[i].clone();
+                *n = lib_reduced("select", args[i].clone());
                 return;
             }
         }
@@ -159,15 +162,29 @@ fn fold_node(c: &Compiled, p: &mut Purity, n: &mut Node, in_func: bool) {
     if in_func && contains_param(n) {
         return;
     }
-    if let Some(v) = try_eval(c, n) {
-        *n = Node::Num(v);
+    if let Some((v, touched)) = try_eval(c, n) {
+        *n = if touched {
+            Node::NumClr(v)
+        } else {
+            Node::Num(v)
+        };
+    }
+}
+
+/// A library call (`if`, `select`) reduced to the argument it returns: a number when
+/// the argument is one (the call clears the error flag), else the argument wrapped so
+/// that it still behaves as the call (flag cleared first, an error inside reported).
+fn lib_reduced(name: &'static str, arg: Node) -> Node {
+    match arg.num() {
+        Some(v) => Node::NumClr(v),
+        None => Node::Lib(name, Box::new(arg)),
     }
 }
 
 fn contains_param(n: &Node) -> bool {
     match n {
         Node::Param(_) | Node::CallParam(..) => true,
-        Node::Neg(a) | Node::Math1(_, a) => contains_param(a),
+        Node::Neg(a) | Node::Math1(_, a) | Node::Lib(_, a) => contains_param(a),
         Node::Add(q)
         | Node::Sub(q)
         | Node::Mul(q)
@@ -196,8 +213,13 @@ pub(crate) fn fold(c: &mut Compiled) -> Vec<usize> {
             continue;
         }
         let node = Node::Var(i as u32);
-        if let Some(v) = try_eval(c, &node) {
-            c.vars[i] = VarSlot::Const(v);
+        if let Some((v, touched)) = try_eval(c, &node) {
+            let constant = matches!(c.vars[i], VarSlot::Def(_, true));
+            c.vars[i] = if touched && !constant {
+                VarSlot::ConstClr(v)
+            } else {
+                VarSlot::Const(v)
+            };
         } else if matches!(c.vars[i], VarSlot::Def(_, true)) {
             let mut st = c.state();
             if crate::eval::probe(c, &node, &mut st).is_some() && st.take_warnings().any() {

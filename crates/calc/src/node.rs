@@ -14,6 +14,11 @@ pub(crate) enum FnTarget {
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) enum Node {
     Num(f64),
+    /// A folded library call's value: also clears the error flag, as the call would.
+    NumClr(f64),
+    /// A library call reduced to the argument it returns (a folded `if`/`select`): it
+    /// still clears the error flag first and reports an error raised inside.
+    Lib(&'static str, Box<Node>),
     /// A global variable (host-bound or defined).
     Var(u32),
     /// `$N` (1-based).
@@ -45,7 +50,7 @@ impl Node {
     /// The constant value, if this is a number.
     pub(crate) fn num(&self) -> Option<f64> {
         match self {
-            Node::Num(v) => Some(*v),
+            Node::Num(v) | Node::NumClr(v) => Some(*v),
             _ => None,
         }
     }
