@@ -2,7 +2,7 @@
 # rcalc speed against the oracle, same run, same machine (issue 3): the bin expressions a
 # contribution run evaluates per ray hit, over 1 000 000 random directions.
 #   kbin  : rcalc -f klems_full.cal -e '$1=kbin(0,1,0,0,0,1)'-style Klems bin of each direction
-#   rbin  : rcalc -e MF:4 -f reinhart.cal -e 'Dx=$1;Dy=$2;Dz=$3;$1=rbin'
+#   rbin  : rcalc -e MF:1 -f reinhart.cal -e 'Dx=$1;Dy=$2;Dz=$3;$1=rbin'
 # Each tool reads its own .cal files (ours from lib/, Radiance's from its library).
 # Usage: benches/rcalc.sh [runs]   (needs .oracle/env, hyperfine, and a testopt build of rcalc)
 set -euo pipefail
@@ -23,8 +23,8 @@ b='Dx=$1;Dy=$2;Dz=$3;$1=rbin'
 hyperfine -N -w 1 -r "$runs" --export-markdown "$tmp/times.md" \
   -n "oracle kbin" "env RAYPATH=$FENESTRA_ORACLE_LIB $FENESTRA_ORACLE_BIN/rcalc -f klems_full.cal -e $k $tmp/dirs.txt" \
   -n "fenestra kbin" "env FENESTRA_LIB=$PWD/lib RAYPATH=. $ours -f klems_full.cal -e $k $tmp/dirs.txt" \
-  -n "oracle rbin" "env RAYPATH=$FENESTRA_ORACLE_LIB $FENESTRA_ORACLE_BIN/rcalc -e MF:4 -f reinhart.cal -e $b $tmp/dirs.txt" \
-  -n "fenestra rbin" "env FENESTRA_LIB=$PWD/lib RAYPATH=. $ours -e MF:4 -f reinhart.cal -e $b $tmp/dirs.txt"
+  -n "oracle rbin" "env RAYPATH=$FENESTRA_ORACLE_LIB $FENESTRA_ORACLE_BIN/rcalc -e MF:1 -f reinhart.cal -e $b $tmp/dirs.txt" \
+  -n "fenestra rbin" "env FENESTRA_LIB=$PWD/lib RAYPATH=. $ours -e MF:1 -f reinhart.cal -e $b $tmp/dirs.txt"
 cat "$tmp/times.md"
 # The outputs must agree (same bins) for the timing to mean anything.
 env RAYPATH=$FENESTRA_ORACLE_LIB $FENESTRA_ORACLE_BIN/rcalc -f klems_full.cal -e "$k" "$tmp/dirs.txt" > "$tmp/o.txt"
