@@ -1317,3 +1317,82 @@ fn picture_output_to_openexr() {
         }
     }
 }
+
+#[test]
+fn oracle_limited_ray_distance() {
+    // -ld+: a ray ends at the length of its direction vector (a lamp 3 m away is seen by
+    // rays longer than 3 m only; nothing is seen of a distant source); -ld- ignores the
+    // length; -i carries the remaining length through glass; -I ignores it. With -ab 0
+    // each ray reaches one glow or nothing, so values must be identical to the oracle's.
+    let dir = common::scratch("rtcontrib_ld");
+    let opaque = dir.join("opaque.rad");
+    let glazed = dir.join("glazed.rad");
+    let lamp = "void glow lampglow 0 0 4 1 1 1 0\n\
+                lampglow polygon lamp 0 0 12 -5 3 -5 5 3 -5 5 3 5 -5 3 5\n\
+                void plastic wallm 0 0 5 .5 .5 .5 0 0\n\
+                wallm polygon floor 0 0 12 -5 0 -1 5 0 -1 5 9 -1 -5 9 -1\n\
+                void glow skyg 0 0 4 1 1 1 0\n\
+                skyg source sky 0 0 4 0 0 1 180\n";
+    std::fs::write(&opaque, lamp).unwrap();
+    std::fs::write(
+        &glazed,
+        format!(
+            "{lamp}void glass pane 0 0 3 .9 .9 .9\n\
+             pane polygon win 0 0 12 -5 1 -5 -5 1 5 5 1 5 5 1 -5\n"
+        ),
+    )
+    .unwrap();
+    let rays = b"0 0 0 0 0.5 0\n0 0 0 0 2.9 0\n0 0 0 0 3.1 0\n0 0 0 0 1 1\n0 0 0 0 10 10\n\
+                 0 0 0 1 0 0\n0 0 0 0 0 3\n0 0 0 0 0 -0.5\n";
+    let mods = ["-m", "lampglow", "-m", "skyg"];
+    let ours = |scene: &Path, opts: &[&str], input: &[u8]| {
+        let mut a = vec!["-w", "-h", "-ab", "0"];
+        a.extend_from_slice(opts);
+        a.extend_from_slice(&mods);
+        let s = scene.display().to_string();
+        a.push(&s);
+        nums(&ok(rc(&a), input))
+    };
+    // what Radiance 6.0a gives (the 2nd column pair is the sky)
+    let lamp_seen = [0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.0, 0.0];
+    let got = ours(&opaque, &["-ld+"], rays);
+    for (k, want) in lamp_seen.iter().enumerate() {
+        assert_eq!(got[6 * k], *want, "-ld+ ray {k}");
+        assert_eq!(got[6 * k + 3], 0.0, "-ld+ ray {k} sky");
+    }
+    let unlimited = ours(&opaque, &["-ld-"], rays);
+    assert_eq!(unlimited[6 * 6 + 3], 1.0, "-ld- sees the sky");
+    // -i through the glass pane at 1 m: the lamp at 3 m needs a length above 3
+    let got = ours(&glazed, &["-i+", "-ld+"], b"0 0 0 0 2.9 0\n0 0 0 0 3.1 0\n");
+    assert_eq!(got[0], 0.0);
+    assert_eq!(got[6], 1.0);
+    // a transmitting surface within the length: a clear error (not supported)
+    let s = glazed.display().to_string();
+    let o = run_in(
+        rc(&["-w", "-h", "-ab", "0", "-ld+", "-m", "lampglow", &s]),
+        b"0 0 0 0 2 0\n",
+    );
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("not supported"));
+
+    let Some(o) = common::oracle() else { return };
+    for (scene, opts, input) in [
+        (&opaque, vec!["-ld+"], &rays[..]),
+        (&opaque, vec!["-ld-"], &rays[..]),
+        (
+            &glazed,
+            vec!["-i+", "-ld+"],
+            &b"0 0 0 0 2.9 0\n0 0 0 0 3.1 0\n"[..],
+        ),
+    ] {
+        let oct = oracle_octree(&o, &dir, &[scene.display().to_string()]);
+        let mut a = vec!["-w", "-h", "-ab", "0"];
+        a.extend_from_slice(&opts);
+        a.extend_from_slice(&mods);
+        a.push(&oct);
+        let mut c = o.command("rcontrib");
+        c.args(&a);
+        let want = nums(&ok(c, input));
+        assert_eq!(ours(scene, &opts, input), want, "{opts:?}");
+    }
+}

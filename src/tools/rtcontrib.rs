@@ -67,6 +67,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         (false, false, true, true, false, false);
     let mut recover = false;
     let mut irr_hit = false;
+    let mut limit_dist = false;
     let mut count = 1usize;
     let (mut xres, mut yres, mut nproc, mut batches) = (0usize, 0usize, 1usize, 4usize);
     let (mut fin, mut fout) = (InFormat::Ascii, Format::Ascii);
@@ -206,10 +207,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             // -u: fenestra's random streams are always keyed by the seed and ray index.
         } else if let Some(v) = toggle(a, "i", irr_hit) {
             irr_hit = v;
-        } else if let Some(v) = toggle(a, "ld", false) {
-            if v {
-                bail!("-ld+ (ray length limited by the direction's length) is not supported by fenestra's rtcontrib");
-            }
+        } else if let Some(v) = toggle(a, "ld", limit_dist) {
+            limit_dist = v;
         } else if let Some(v) = toggle(a, "r", recover) {
             recover = v;
         } else if a == "-f" {
@@ -413,6 +412,38 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             .collect()
     });
 
+    // -ld+ (not with -I, which ignores the length as Radiance does): which surfaces end
+    // a ray, i.e. whose material has no straight continuation (glass, trans, illum,
+    // BSDF... would carry the remaining length on, which fenestra does not support)
+    let stops = (limit_dist && !irr).then(|| {
+        scene
+            .prims
+            .iter()
+            .map(|p| {
+                let t = p
+                    .modifier
+                    .map(|m| scene.prims[m].ptype.as_str())
+                    .unwrap_or("");
+                matches!(
+                    t,
+                    "plastic"
+                        | "metal"
+                        | "plastic2"
+                        | "metal2"
+                        | "plasfunc"
+                        | "metfunc"
+                        | "plasdata"
+                        | "metdata"
+                        | "mirror"
+                        | "glow"
+                        | "light"
+                        | "spotlight"
+                        | "ashik2"
+                )
+            })
+            .collect()
+    });
+
     // Input.
     let expect = if yres > 0 {
         Some(yres * xres.max(1) * count.max(1))
@@ -429,6 +460,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     if dynamic {
         let probe_opts = RunOptions {
             irradiance_at_hit: hit_kinds.clone(),
+            limit_dist: stops.clone(),
             irradiance: irr,
             value,
             // the same random streams as the main pass: replicas with -E -c 1, ray
@@ -564,6 +596,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
 
     let opts = RunOptions {
         irradiance_at_hit: hit_kinds,
+        limit_dist: stops,
         irradiance: irr,
         value,
         count,

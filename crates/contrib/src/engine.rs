@@ -136,6 +136,9 @@ pub struct RunOptions {
     pub errors: bool,
     /// With `-c 1` and errors: independent batches per ray (the value is their mean).
     pub batches: usize,
+    /// `-ld+`: rays end at the length of their direction vector; per scene primitive,
+    /// whether a ray hitting it stops there (no straight continuation).
+    pub limit_dist: Option<Vec<bool>>,
 }
 
 /// One output record: values and (when asked) standard errors, `3 × total bins` each.
@@ -167,8 +170,16 @@ pub struct Engine<'a> {
 struct Acc {
     sum: Vec<f64>,
     sumsq: Vec<f64>,
-    tmp: Vec<f64>,
     n: usize,
+}
+
+/// Per-thread working state: bin evaluation states, bad bins met (merged into the
+/// engine's set once per record), and the one-ray values of error mode.
+struct Scratch {
+    states: Vec<State>,
+    bad: BTreeSet<(usize, i64)>,
+    tmp: Vec<f64>,
+    touched: Vec<usize>,
 }
 
 impl<'a> Engine<'a> {
@@ -217,10 +228,29 @@ impl<'a> Engine<'a> {
         std::mem::take(&mut *b).into_iter().collect()
     }
 
-    fn trace_one(&self, index: u64, ray: &InputRay, acc: &mut [f64], states: &mut [State]) {
+    /// Traces one input ray, adding its contributions into `acc`; with `touched`, the
+    /// index of every RGB slot that was zero before is pushed (for the error sums).
+    fn scratch(&self) -> Scratch {
+        Scratch {
+            states: self.bins.states(),
+            bad: BTreeSet::new(),
+            tmp: Vec::new(),
+            touched: Vec::new(),
+        }
+    }
+
+    fn trace_one(
+        &self,
+        index: u64,
+        ray: &InputRay,
+        acc: &mut [f64],
+        mut touched: Option<&mut Vec<usize>>,
+        scratch: &mut Scratch,
+    ) {
         if ray.dir == DVec3::ZERO {
             return;
         }
+        let Scratch { states, bad, .. } = scratch;
         let mut sink = |c: Contribution| {
             let m = self.our_mod[c.modifier];
             if m == u32::MAX {
@@ -239,19 +269,13 @@ impl<'a> Engine<'a> {
                         }
                         let bn = (bv + 0.5) as i64;
                         if bn as usize >= self.nbins[m] {
-                            self.bad
-                                .lock()
-                                .unwrap_or_else(|e| e.into_inner())
-                                .insert((m, bn));
+                            bad.insert((m, bn));
                             return;
                         }
                         bn as usize
                     }
                     Err(e) => {
-                        let mut f = self.fail.lock().unwrap_or_else(|e| e.into_inner());
-                        if f.is_none() {
-                            *f = Some(e.to_string());
-                        }
+                        self.set_fail(format!("bin expression: {e}"));
                         return;
                     }
                 }
@@ -259,6 +283,11 @@ impl<'a> Engine<'a> {
                 0
             };
             let s = (self.offsets[m] + b) * 3;
+            if let Some(t) = touched.as_deref_mut() {
+                if acc[s] == 0.0 && acc[s + 1] == 0.0 && acc[s + 2] == 0.0 {
+                    t.push(s);
+                }
+            }
             acc[s] += v[0];
             acc[s + 1] += v[1];
             acc[s + 2] += v[2];
@@ -266,8 +295,20 @@ impl<'a> Engine<'a> {
         if let Some(kinds) = &self.opts.irradiance_at_hit {
             let d = ray.dir.normalize();
             let mut o = ray.org;
+            // -ld+: what is left of the ray's length (passing surfaces does not reset it)
+            let mut left = if self.opts.limit_dist.is_some() {
+                ray.dir.length()
+            } else {
+                f64::INFINITY
+            };
             for _ in 0..100 {
                 let h = self.tracer.first_hit(o, d);
+                if left.is_finite() {
+                    if h.prim.is_none() || h.t >= left {
+                        return;
+                    }
+                    left -= h.t;
+                }
                 match h
                     .prim
                     .map(|p| kinds.get(p).copied().unwrap_or(HitKind::Opaque))
@@ -296,12 +337,35 @@ impl<'a> Engine<'a> {
             self.tracer
                 .contributions_irradiance(index, ray.org, ray.dir, &self.tracked, &mut sink);
         } else {
+            if let Some(stops) = &self.opts.limit_dist {
+                // -ld+: the ray ends at the length of its direction vector. Without a
+                // surface before that point nothing is seen (not even a distant
+                // source); a surface the ray would continue through is not supported.
+                let len = ray.dir.length();
+                let h = self.tracer.first_hit(ray.org, ray.dir);
+                match h.prim {
+                    Some(p) if h.t < len => {
+                        if !stops.get(p).copied().unwrap_or(false) {
+                            self.set_fail(format!(
+                                "-ld+: the ray from {} {} {} (length {len}) reaches a surface it would continue through (transmitting or pass-through material) at distance {}; limiting the continued ray is not supported by fenestra's rtcontrib",
+                                ray.org.x, ray.org.y, ray.org.z, h.t
+                            ));
+                            return;
+                        }
+                    }
+                    _ => return,
+                }
+            }
             self.tracer
                 .contributions(index, ray.org, ray.dir, &self.tracked, &mut sink);
         }
     }
 
-    fn accumulate(&self, rays: impl Iterator<Item = (u64, InputRay)>, states: &mut [State]) -> Acc {
+    fn accumulate(
+        &self,
+        rays: impl Iterator<Item = (u64, InputRay)>,
+        scratch: &mut Scratch,
+    ) -> Acc {
         let n3 = self.total * 3;
         let mut a = Acc {
             sum: vec![0.0; n3],
@@ -309,22 +373,36 @@ impl<'a> Engine<'a> {
         };
         if self.opts.errors {
             a.sumsq = vec![0.0; n3];
-            a.tmp = vec![0.0; n3];
+            if scratch.tmp.len() != n3 {
+                scratch.tmp = vec![0.0; n3];
+            }
         }
         for (idx, r) in rays {
             a.n += 1;
             if self.opts.errors {
-                a.tmp.iter_mut().for_each(|x| *x = 0.0);
-                let mut tmp = std::mem::take(&mut a.tmp);
-                self.trace_one(idx, &r, &mut tmp, states);
-                for ((s, q), t) in a.sum.iter_mut().zip(a.sumsq.iter_mut()).zip(&tmp) {
-                    *s += t;
-                    *q += t * t;
+                // only the slots this ray reached are added (adding zeros would not
+                // change the sums) and reset
+                let mut tmp = std::mem::take(&mut scratch.tmp);
+                let mut touched = std::mem::take(&mut scratch.touched);
+                touched.clear();
+                self.trace_one(idx, &r, &mut tmp, Some(&mut touched), scratch);
+                for &s in &touched {
+                    let sums = a.sum[s..s + 3].iter_mut().zip(&mut a.sumsq[s..s + 3]);
+                    for ((sum, sq), t) in sums.zip(&mut tmp[s..s + 3]) {
+                        *sum += *t;
+                        *sq += *t * *t;
+                        *t = 0.0;
+                    }
                 }
-                a.tmp = tmp;
+                scratch.tmp = tmp;
+                scratch.touched = touched;
             } else {
-                self.trace_one(idx, &r, &mut a.sum, states);
+                self.trace_one(idx, &r, &mut a.sum, None, scratch);
             }
+        }
+        if !scratch.bad.is_empty() {
+            let mut b = self.bad.lock().unwrap_or_else(|e| e.into_inner());
+            b.append(&mut scratch.bad);
         }
         a
     }
@@ -359,9 +437,17 @@ impl<'a> Engine<'a> {
         }
     }
 
+    /// Keeps the first error met while tracing (reported when the block ends).
+    fn set_fail(&self, msg: String) {
+        let mut f = self.fail.lock().unwrap_or_else(|e| e.into_inner());
+        if f.is_none() {
+            *f = Some(msg);
+        }
+    }
+
     fn check_fail(&self) -> Result<()> {
         if let Some(e) = self.fail.lock().unwrap_or_else(|e| e.into_inner()).take() {
-            return Err(anyhow!("bin expression: {e}"));
+            return Err(anyhow!("{e}"));
         }
         Ok(())
     }
@@ -384,18 +470,18 @@ impl<'a> Engine<'a> {
             (first..first + n)
                 .into_par_iter()
                 .map_init(
-                    || self.bins.states(),
-                    |states, r| {
+                    || self.scratch(),
+                    |scratch, r| {
                         let acc = if batches > 1 {
                             let ray = rays[r];
                             self.accumulate(
                                 (0..batches).map(|j| ((r * batches + j) as u64, ray)),
-                                states,
+                                scratch,
                             )
                         } else {
                             let lo = r * c;
                             let hi = (lo + c).min(rays.len());
-                            self.accumulate((lo..hi).map(|k| (k as u64, rays[k])), states)
+                            self.accumulate((lo..hi).map(|k| (k as u64, rays[k])), scratch)
                         };
                         self.finish(acc, false)
                     },
@@ -433,9 +519,9 @@ impl<'a> Engine<'a> {
                 block
                     .par_chunks(CHUNK)
                     .map_init(
-                        || self.bins.states(),
-                        |states, ch| {
-                            self.accumulate(ch.iter().map(|&k| (k as u64, rays[k])), states)
+                        || self.scratch(),
+                        |scratch, ch| {
+                            self.accumulate(ch.iter().map(|&k| (k as u64, rays[k])), scratch)
                         },
                     )
                     .collect()

@@ -470,6 +470,8 @@ pub struct Stream {
     pub plan: StreamPlan,
     dest: Dest,
     buf: Vec<u8>,
+    /// Scratch text of one number (ASCII output).
+    txt: String,
 }
 
 /// Checks that files can be created (no existing file unless `overwrite`).
@@ -544,6 +546,7 @@ impl Stream {
         };
         let mut s = Stream {
             buf: header_text(&plan, info),
+            txt: String::new(),
             plan,
             dest,
         };
@@ -575,6 +578,7 @@ impl Stream {
             plan,
             dest: Dest::File(f),
             buf: Vec::new(),
+            txt: String::new(),
         })
     }
 
@@ -625,7 +629,9 @@ impl Stream {
             match format {
                 Format::Ascii => {
                     for c in v {
-                        self.buf.extend_from_slice(fmt_e(c).as_bytes());
+                        self.txt.clear();
+                        fenestra_formats::matrix::format_c_e(&mut self.txt, c, 6);
+                        self.buf.extend_from_slice(self.txt.as_bytes());
                         self.buf.push(b'\t');
                     }
                 }
@@ -700,23 +706,6 @@ impl Stream {
     }
 }
 
-/// C's `%e`: 6 digits after the point, exponent with sign and at least two digits.
-pub fn fmt_e(v: f64) -> String {
-    if !v.is_finite() {
-        return if v.is_nan() {
-            "nan".into()
-        } else if v > 0.0 {
-            "inf".into()
-        } else {
-            "-inf".into()
-        };
-    }
-    let s = format!("{v:.6e}");
-    let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
-    let e: i32 = e.parse().unwrap_or(0);
-    format!("{m}e{}{:02}", if e < 0 { '-' } else { '+' }, e.abs())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -729,13 +718,6 @@ mod tests {
         assert!(Spec::parse("a%f").is_err());
         assert!(Spec::parse("a%d%d").is_err());
         assert_eq!(Spec::parse("v%x").unwrap().expand("m", 255), "vff");
-    }
-
-    #[test]
-    fn c_style_exponent() {
-        assert_eq!(fmt_e(1.23456789), "1.234568e+00");
-        assert_eq!(fmt_e(-2.5e-7), "-2.500000e-07");
-        assert_eq!(fmt_e(0.0), "0.000000e+00");
     }
 
     #[test]
