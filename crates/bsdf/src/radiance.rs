@@ -13,8 +13,15 @@
 //! Radiance splits each component's minimum off as a Lambertian part when it exceeds 0.01/π and
 //! drops the remainder when its largest hemispherical total is ≤ 0.001; only that last case
 //! changes a transmission matrix (the split itself is added back), so it is what is reproduced.
-//! Colour: with `CIE-X` and `CIE-Z` blocks the RGB value of each element is the XYZ → RGB
-//! transform (Radiance's standard primaries, equal-energy white) of (X, Y, Z); grey otherwise.
+//! Colour: with `CIE-X` and `CIE-Z` blocks Radiance keeps each element's CIE Y and stores its
+//! chromaticity (u′, v′) quantised to steps of 1/410 with a dither: `k = floor(410·u′ + r)`,
+//! r from the C library's `drand48()` in its unseeded state (two numbers per element, u′ then
+//! v′). Found by experiment against the oracle's `rmtxop -ff`: the coloured components are
+//! encoded in the order XML `Reflection Back`, `Reflection Front`, `Transmission Back`,
+//! `Transmission Front` (Radiance rf, rb, tf, tb), each element of a component from the last
+//! stored index (`o·n_in + i`) down to the first, zero elements included. The RGB value is the
+//! XYZ → RGB transform (Radiance's standard primaries, equal-energy white) of (x/y·Y, Y,
+//! (1−x−y)/y·Y) from the decoded chromaticity; grey Y without colour blocks.
 
 use crate::klems::KlemsBasis;
 use crate::model::{Bsdf, Direction, KlemsMatrix, Wavelength};
@@ -112,49 +119,131 @@ fn inv3(m: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
     ]
 }
 
-/// Colour value (RGB) of element (o, i) of a component: grey Y, or XYZ → RGB with X and Z.
+/// The C library's `drand48()` generator (48-bit linear congruential, glibc's unseeded state 0).
+#[derive(Clone, Debug, Default)]
+pub struct Drand48 {
+    state: u64,
+}
+
+impl Drand48 {
+    /// The generator in its unseeded state.
+    pub const fn new() -> Self {
+        Drand48 { state: 0 }
+    }
+
+    /// The next number in [0, 1).
+    pub fn next_f64(&mut self) -> f64 {
+        const A: u64 = 0x5_DEEC_E66D;
+        const MASK: u64 = (1 << 48) - 1;
+        self.state = (A.wrapping_mul(self.state).wrapping_add(0xB)) & MASK;
+        self.state as f64 / (1u64 << 48) as f64
+    }
+}
+
+/// Steps per unit of u′ and v′ in Radiance's chromaticity encoding.
+const UV_STEPS: f64 = 410.0;
+
+/// Dithered (u′, v′) lattice indices of every element of a coloured component, indexed
+/// `o · n_in + i`; `None` where X + 15Y + 3Z is not positive.
+fn encode_chroma(
+    y: &KlemsMatrix,
+    x: &KlemsMatrix,
+    z: &KlemsMatrix,
+    rng: &mut Drand48,
+) -> Vec<Option<(f64, f64)>> {
+    let (ni, no) = (y.incident.len(), y.outgoing.len());
+    let mut out = vec![None; ni * no];
+    for k in (0..ni * no).rev() {
+        let (o, i) = (k / ni, k % ni);
+        let (cx, cy, cz) = (x.get(o, i), y.get(o, i), z.get(o, i));
+        let (r1, r2) = (rng.next_f64(), rng.next_f64());
+        let d = cx + 15.0 * cy + 3.0 * cz;
+        if d > 0.0 {
+            let ub = (4.0 * cx / d * UV_STEPS + r1).floor().clamp(0.0, 255.0);
+            let vb = (9.0 * cy / d * UV_STEPS + r2).floor().clamp(0.0, 255.0);
+            out[k] = Some((ub, vb));
+        }
+    }
+    out
+}
+
+/// Colour value (RGB) of element (o, i) of a component: grey Y, or Y with the component's
+/// quantised chromaticity.
 struct Component<'a> {
     y: &'a KlemsMatrix,
-    x: Option<&'a KlemsMatrix>,
-    z: Option<&'a KlemsMatrix>,
+    chroma: Option<Vec<Option<(f64, f64)>>>,
     m: [[f64; 3]; 3],
 }
 
 impl Component<'_> {
     fn rgb(&self, o: usize, i: usize) -> [f64; 3] {
         let y = self.y.get(o, i);
-        match (self.x, self.z) {
-            (Some(x), Some(z)) => {
-                let c = mul3(&self.m, [x.get(o, i), y, z.get(o, i)]);
-                [c[0].max(0.0), c[1].max(0.0), c[2].max(0.0)]
-            }
-            _ => [y; 3],
+        let Some(chroma) = &self.chroma else {
+            return [y; 3];
+        };
+        let Some((ub, vb)) = chroma[o * self.y.incident.len() + i] else {
+            return [y; 3];
+        };
+        let (u, v) = (ub / UV_STEPS, vb / UV_STEPS);
+        let d = 6.0 * u - 16.0 * v + 12.0;
+        let (cx, cy) = (9.0 * u / d, 4.0 * v / d);
+        if cy <= 0.0 {
+            return [y; 3];
         }
+        let c = mul3(&self.m, [cx / cy * y, y, (1.0 - cx - cy) / cy * y]);
+        [c[0].max(0.0), c[1].max(0.0), c[2].max(0.0)]
     }
 }
 
-fn component<'a>(b: &'a Bsdf, d: Direction) -> Result<Option<Component<'a>>, MatrixError> {
-    let Some(blk) = b.block(d, &Wavelength::Visible) else {
-        return Ok(None);
-    };
-    let y = match &blk.data {
-        crate::model::BlockData::Klems(m) => m,
-        crate::model::BlockData::Tree(_) => return Err(MatrixError::TensorTree),
-    };
-    let x = b.klems(d, &Wavelength::CieX);
-    let z = b.klems(d, &Wavelength::CieZ);
-    let same = |m: Option<&KlemsMatrix>| {
-        m.is_none_or(|m| m.incident == y.incident && m.outgoing == y.outgoing)
-    };
-    if !same(x) || !same(z) {
-        return Err(MatrixError::ColourBasis(d.xml_name()));
+/// The order in which Radiance encodes the coloured components (rf, rb, tf, tb).
+const ENCODE_ORDER: [Direction; 4] = [
+    Direction::ReflectionBack,
+    Direction::ReflectionFront,
+    Direction::TransmissionBack,
+    Direction::TransmissionFront,
+];
+
+/// Component `d` of `b`, encoding the colour of every coloured component with `rng` (as
+/// Radiance's loader does whichever component is asked for).
+fn component<'a>(
+    b: &'a Bsdf,
+    d: Direction,
+    rng: &mut Drand48,
+) -> Result<Option<Component<'a>>, MatrixError> {
+    let mut found = None;
+    for dir in ENCODE_ORDER {
+        let Some(blk) = b.block(dir, &Wavelength::Visible) else {
+            continue;
+        };
+        let y = match &blk.data {
+            crate::model::BlockData::Klems(m) => m,
+            crate::model::BlockData::Tree(_) if dir == d => return Err(MatrixError::TensorTree),
+            crate::model::BlockData::Tree(_) => continue,
+        };
+        let x = b.klems(dir, &Wavelength::CieX);
+        let z = b.klems(dir, &Wavelength::CieZ);
+        let same = |m: Option<&KlemsMatrix>| {
+            m.is_none_or(|m| m.incident == y.incident && m.outgoing == y.outgoing)
+        };
+        if !same(x) || !same(z) {
+            if dir == d {
+                return Err(MatrixError::ColourBasis(d.xml_name()));
+            }
+            continue;
+        }
+        let chroma = match (x, z) {
+            (Some(x), Some(z)) => Some(encode_chroma(y, x, z, rng)),
+            _ => None,
+        };
+        if dir == d {
+            found = Some(Component {
+                y,
+                chroma,
+                m: xyz_to_rgb_matrix(),
+            });
+        }
     }
-    Ok(Some(Component {
-        y,
-        x,
-        z,
-        m: xyz_to_rgb_matrix(),
-    }))
+    Ok(found)
 }
 
 /// Lambertian value Radiance would split off a matrix (its minimum if > 0.01/π), and whether
@@ -175,10 +264,24 @@ pub fn lambertian_split(m: &KlemsMatrix) -> (f64, bool) {
     (lamb, keep)
 }
 
-#[allow(clippy::needless_range_loop)] // index arithmetic mirrors the formulas
-/// The transmission matrix Radiance's `dctimestep`/`rmtxop` build from this BSDF.
+/// The transmission matrix Radiance's `dctimestep`/`rmtxop` build from this BSDF (colour
+/// dither from a fresh generator, as the first BSDF a Radiance process loads).
 pub fn transmission_matrix(b: &Bsdf) -> Result<RgbMatrix, MatrixError> {
-    if let Some(tb) = component(b, Direction::TransmissionFront)? {
+    transmission_matrix_with(b, &mut Drand48::default())
+}
+
+#[allow(clippy::needless_range_loop)] // index arithmetic mirrors the formulas
+/// [`transmission_matrix`] with the colour dither drawn from `rng` (a Radiance process keeps
+/// one generator for all the BSDFs it loads).
+pub fn transmission_matrix_with(b: &Bsdf, rng: &mut Drand48) -> Result<RgbMatrix, MatrixError> {
+    // Radiance encodes every component once on load: both look-ups start from the same state.
+    let start = rng.clone();
+    let tb = component(b, Direction::TransmissionFront, rng)?;
+    let tf = match tb {
+        None => component(b, Direction::TransmissionBack, &mut start.clone())?,
+        Some(_) => None,
+    };
+    if let Some(tb) = tb {
         let (lamb, keep) = lambertian_split(tb.y);
         if keep {
             let (ni, no) = (tb.y.incident.len(), tb.y.outgoing.len());
@@ -194,7 +297,7 @@ pub fn transmission_matrix(b: &Bsdf) -> Result<RgbMatrix, MatrixError> {
         }
         return Ok(lambertian_only(lamb));
     }
-    if let Some(tf) = component(b, Direction::TransmissionBack)? {
+    if let Some(tf) = tf {
         let (lamb, keep) = lambertian_split(tf.y);
         if keep {
             let (ni, no) = (tf.y.incident.len(), tf.y.outgoing.len());
@@ -239,12 +342,21 @@ fn lambertian_only(value: f64) -> RgbMatrix {
 /// `Reflection Back`) or `-rb` (XML `Reflection Front`): `R[o][i] = BSDF[o][i] · λ_in(i)`.
 /// `None` when the file has no such block.
 pub fn reflection_matrix(b: &Bsdf, front: bool) -> Result<Option<RgbMatrix>, MatrixError> {
+    reflection_matrix_with(b, front, &mut Drand48::default())
+}
+
+/// [`reflection_matrix`] with the colour dither drawn from `rng`.
+pub fn reflection_matrix_with(
+    b: &Bsdf,
+    front: bool,
+    rng: &mut Drand48,
+) -> Result<Option<RgbMatrix>, MatrixError> {
     let d = if front {
         Direction::ReflectionBack
     } else {
         Direction::ReflectionFront
     };
-    let Some(r) = component(b, d)? else {
+    let Some(r) = component(b, d, rng)? else {
         return Ok(None);
     };
     let (ni, no) = (r.y.incident.len(), r.y.outgoing.len());

@@ -12,6 +12,11 @@ use std::path::Path;
 use anyhow::{bail, Context, Result};
 use fenestra_formats::matrix::{DataFormat, MatrixReader};
 
+/// The process's generator for the colour dither of BSDF XML loads (see
+/// `fenestra_bsdf::radiance`).
+static XML_DITHER: std::sync::Mutex<fenestra_bsdf::radiance::Drand48> =
+    std::sync::Mutex::new(fenestra_bsdf::radiance::Drand48::new());
+
 /// Which matrix an XML BSDF input gives.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum XmlPart {
@@ -229,12 +234,19 @@ impl Mtx {
         let b = fenestra_bsdf::read_file(Path::new(name))
             .map_err(|e| anyhow::anyhow!("{e}"))
             .with_context(|| format!("cannot load BSDF '{name}'"))?;
+        // One colour-dither generator per process, as Radiance's: a second XML operand of the
+        // same command continues the sequence of the first.
+        let mut rng = XML_DITHER
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
         let m = match part {
-            XmlPart::Transmission => fenestra_bsdf::radiance::transmission_matrix(&b)
-                .map_err(|e| anyhow::anyhow!("{name}: {e}"))?,
+            XmlPart::Transmission => {
+                fenestra_bsdf::radiance::transmission_matrix_with(&b, &mut rng)
+                    .map_err(|e| anyhow::anyhow!("{name}: {e}"))?
+            }
             XmlPart::ReflectionFront | XmlPart::ReflectionBack => {
                 let front = part == XmlPart::ReflectionFront;
-                match fenestra_bsdf::radiance::reflection_matrix(&b, front)
+                match fenestra_bsdf::radiance::reflection_matrix_with(&b, front, &mut rng)
                     .map_err(|e| anyhow::anyhow!("{name}: {e}"))?
                 {
                     Some(m) => m,
