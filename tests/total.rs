@@ -94,6 +94,7 @@ fn oracle_random_text_inputs_are_identical() {
             let theirs = run(o.command("total"), &dir, &a, inp.as_bytes());
             let ours = run(common::fenestra("total"), &dir, &a, inp.as_bytes());
             assert!(ours.status.success(), "total {opt}: {:?}", ours.stderr);
+            assert!(theirs.status.success(), "oracle total {opt} failed");
             assert!(
                 theirs.stdout == ours.stdout,
                 "total {opt} on\n{inp}\noracle:\n{}\nours:\n{}",
@@ -131,6 +132,9 @@ fn oracle_binary_inputs_are_identical() {
         let a = words(opt);
         let theirs = run(o.command("total"), &dir, &a, data);
         let ours = run(common::fenestra("total"), &dir, &a, data);
+        assert!(theirs.status.success(), "oracle total {opt} failed");
+        assert!(ours.status.success(), "total {opt}: {:?}", ours.stderr);
+        assert!(!ours.stdout.is_empty(), "total {opt} wrote nothing");
         assert!(theirs.stdout == ours.stdout, "total {opt} differs");
     }
 }
@@ -141,32 +145,41 @@ fn oracle_binary_inputs_are_identical() {
 fn oracle_workflow_pipe_is_identical() {
     let Some(o) = common::oracle() else { return };
     let dir = common::fixture("threephase");
-    let pipe = |bin: &dyn Fn(&str) -> String| {
+    let pipe = |bin: &dyn Fn(&str) -> String, total_opts: &str| {
         let cmd = format!(
-            "{} -fa -c 47.435 119.93 11.635 -t annual_res.dat | {} - | {} && {} -fa -c 47.435 119.93 11.635 -t annual_res.dat | {} - | {} -m -u",
+            "{} -fa -c 47.435 119.93 11.635 -t annual_res.dat | {} - | {} {total_opts}",
             bin("rmtxop"),
             bin("getinfo"),
             bin("total"),
-            bin("rmtxop"),
-            bin("getinfo"),
-            bin("total")
         );
-        let out = Command::new("sh")
-            .arg("-c")
+        let out = Command::new("bash")
+            .args(["-o", "pipefail", "-c"])
             .arg(&cmd)
             .current_dir(&dir)
             .output()
             .unwrap();
         (out.status.success(), out.stdout)
     };
-    let theirs = pipe(&|t| o.bin(t).display().to_string());
     let exe = std::env::current_exe().unwrap();
     let bin_dir = exe.parent().unwrap().parent().unwrap().to_path_buf();
-    let ours = pipe(&|t| bin_dir.join(t).display().to_string());
+    let oracle_bin = |t: &str| o.bin(t).display().to_string();
+    let our_bin = |t: &str| bin_dir.join(t).display().to_string();
+    for opts in ["", "-m", "-u"] {
+        let theirs = pipe(&oracle_bin, opts);
+        let ours = pipe(&our_bin, opts);
+        assert!(theirs.0, "oracle pipe with total {opts} failed");
+        assert!(ours.0, "our pipe with total {opts} failed");
+        assert!(
+            !ours.1.is_empty(),
+            "our pipe with total {opts} wrote nothing"
+        );
+        assert!(theirs.1 == ours.1, "workflow sums with total {opts} differ");
+    }
     // The oracle rejects -m -u ("average maximum?!"), and so do we.
-    assert!(!theirs.0 && !ours.0);
-    assert!(!ours.1.is_empty());
-    assert!(theirs.1 == ours.1, "workflow sums differ");
+    let theirs = pipe(&oracle_bin, "-m -u");
+    let ours = pipe(&our_bin, "-m -u");
+    assert!(!theirs.0 && !ours.0, "total -m -u must fail on both sides");
+    assert!(ours.1.is_empty(), "a rejected total wrote output");
 }
 
 /// Bad options and a partial binary record: a clear message and exit status 1.
@@ -221,8 +234,8 @@ fn oracle_year_sums_reproduce_stored_reference() {
     let exe = std::env::current_exe().unwrap();
     let bin = exe.parent().unwrap().parent().unwrap().to_path_buf();
     let b = |t: &str| bin.join(t).display().to_string();
-    let out = Command::new("sh")
-        .arg("-c")
+    let out = Command::new("bash")
+        .args(["-o", "pipefail", "-c"])
         .arg(format!(
             "{} -fa -c 47.435 119.93 11.635 -t year_res.fmx | {} - | {}",
             b("rmtxop"),
