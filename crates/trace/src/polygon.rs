@@ -25,6 +25,57 @@ pub struct Polygon {
     pts: Vec<DVec2>,
     /// Edge tolerance in projected units.
     tol: f64,
+    /// Projected bounding box (relative to `origin`), grown by `tol`.
+    lo: DVec2,
+    hi: DVec2,
+    /// For a convex polygon: each non-degenerate edge's inward unit normal and offset in
+    /// the projection (`n·q - c` is the signed distance of `q` inside that edge); empty
+    /// for a concave one (which uses the crossing-number test).
+    edges: Vec<(DVec2, f64)>,
+}
+
+/// Inward edge lines of a convex projected polygon, or an empty list if it is not convex
+/// (or winds more than once).
+fn convex_edges(pts: &[DVec2]) -> Vec<(DVec2, f64)> {
+    let n = pts.len();
+    let mut sign = 0.0;
+    let mut turn = 0.0;
+    let mut prev: Option<DVec2> = None;
+    let mut dirs = Vec::with_capacity(n);
+    for i in 0..n {
+        let e = pts[(i + 1) % n] - pts[i];
+        if e.length_squared() > 0.0 {
+            dirs.push((i, e));
+        }
+    }
+    if dirs.len() < 3 {
+        return Vec::new();
+    }
+    for k in 0..=dirs.len() {
+        let e = dirs[k % dirs.len()].1;
+        if let Some(p) = prev {
+            let c = p.perp_dot(e);
+            if c != 0.0 {
+                if sign == 0.0 {
+                    sign = c.signum();
+                } else if c.signum() != sign {
+                    return Vec::new();
+                }
+            }
+            turn += c.atan2(p.dot(e));
+        }
+        prev = Some(e);
+    }
+    if sign == 0.0 || (turn.abs() - 2.0 * std::f64::consts::PI).abs() > 1e-6 {
+        return Vec::new();
+    }
+    dirs.iter()
+        .map(|&(i, e)| {
+            // inward normal: left of the edge for counter-clockwise order
+            let nrm = DVec2::new(-e.y, e.x) * sign / e.length();
+            (nrm, nrm.dot(pts[i]))
+        })
+        .collect()
 }
 
 /// Why a polygon cannot be used.
@@ -96,13 +147,21 @@ impl Polygon {
         } else {
             (0, 1)
         };
-        let pts = verts
+        let pts: Vec<DVec2> = verts
             .iter()
             .map(|v| {
                 let d = *v - origin;
                 DVec2::new(d[axes.0], d[axes.1])
             })
             .collect();
+        let tol = 1e-10 * size;
+        let mut lo = DVec2::splat(f64::INFINITY);
+        let mut hi = DVec2::splat(f64::NEG_INFINITY);
+        for q in &pts {
+            lo = lo.min(*q);
+            hi = hi.max(*q);
+        }
+        let edges = convex_edges(&pts);
         Ok((
             Polygon {
                 origin,
@@ -111,7 +170,10 @@ impl Polygon {
                 area,
                 axes,
                 pts,
-                tol: 1e-10 * size,
+                tol,
+                lo: lo - DVec2::splat(tol),
+                hi: hi + DVec2::splat(tol),
+                edges,
             },
             warn,
         ))
@@ -134,6 +196,13 @@ impl Polygon {
     }
 
     fn contains(&self, q: DVec2) -> bool {
+        if q.x < self.lo.x || q.y < self.lo.y || q.x > self.hi.x || q.y > self.hi.y {
+            return false;
+        }
+        if !self.edges.is_empty() {
+            let lim = -self.tol;
+            return self.edges.iter().all(|(n, c)| n.dot(q) - c >= lim);
+        }
         let n = self.pts.len();
         let mut inside = false;
         let mut j = n - 1;
@@ -254,6 +323,55 @@ mod tests {
         assert_eq!(rep.err(), Some(PolygonError::Degenerate));
         let two = Polygon::new(vec![DVec3::ZERO, DVec3::X]);
         assert_eq!(two.err(), Some(PolygonError::TooFewVertices(2)));
+    }
+
+    #[test]
+    fn convex_edge_test_agrees_with_crossing_test() {
+        let hex: Vec<DVec3> = (0..6)
+            .map(|k| {
+                let a = k as f64 * std::f64::consts::PI / 3.0;
+                DVec3::new(a.cos(), 0.3 * a.cos() + 0.2, a.sin())
+            })
+            .collect();
+        let tri = vec![
+            DVec3::ZERO,
+            DVec3::new(0.0, 0.0, 1.0),
+            DVec3::new(2.0, 1.0, 0.5),
+        ];
+        // clockwise quad with a repeated vertex
+        let quad = vec![
+            DVec3::ZERO,
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+        ];
+        for verts in [hex, tri, quad] {
+            let p = Polygon::new(verts).unwrap().0;
+            assert!(!p.edges.is_empty());
+            let mut q = p.clone();
+            q.edges.clear();
+            let mut rng = crate::rng::Rng::for_ray(5, 5);
+            let mut inside = 0;
+            for _ in 0..20000 {
+                let pt = DVec2::new(rng.next_f64() * 5.0 - 2.5, rng.next_f64() * 5.0 - 2.5);
+                assert_eq!(p.contains(pt), q.contains(pt), "{pt}");
+                inside += usize::from(p.contains(pt));
+            }
+            assert!(inside > 300, "{inside}");
+        }
+        // a concave polygon and a pentagram keep the crossing test
+        let l = [(0., 0.), (2., 0.), (2., 1.), (1., 1.), (1., 2.), (0., 2.)];
+        let star: Vec<(f64, f64)> = (0..5)
+            .map(|k| {
+                let a = k as f64 * 4.0 * std::f64::consts::PI / 5.0;
+                (a.cos(), a.sin())
+            })
+            .collect();
+        for pts in [l.to_vec(), star] {
+            let verts = pts.iter().map(|&(x, y)| DVec3::new(x, y, 0.0)).collect();
+            assert!(Polygon::new(verts).unwrap().0.edges.is_empty());
+        }
     }
 
     #[test]

@@ -5,7 +5,6 @@
 //! primary ray, which rcontrib records). Random numbers come from one stream per input
 //! ray ([`Rng::for_ray`]), used in a fixed order, so results do not depend on threads.
 
-use std::collections::HashMap;
 use std::f64::consts::PI;
 
 use anyhow::{bail, Result};
@@ -66,8 +65,44 @@ struct Ray {
     start: f64,
 }
 
+/// A map from scene index to value stored densely (indexing is a bounds check, not a hash).
+struct Dense<T>(Vec<Option<T>>);
+
+impl<T> Default for Dense<T> {
+    fn default() -> Self {
+        Dense(Vec::new())
+    }
+}
+
+impl<T> Dense<T> {
+    fn get(&self, k: &usize) -> Option<&T> {
+        self.0.get(*k).and_then(Option::as_ref)
+    }
+    fn contains_key(&self, k: &usize) -> bool {
+        self.get(k).is_some()
+    }
+    fn insert(&mut self, k: usize, v: T) {
+        if self.0.len() <= k {
+            self.0.resize_with(k + 1, || None);
+        }
+        self.0[k] = Some(v);
+    }
+    fn values(&self) -> impl Iterator<Item = &T> {
+        self.0.iter().flatten()
+    }
+}
+
+impl<T> std::ops::Index<&usize> for Dense<T> {
+    type Output = T;
+    fn index(&self, k: &usize) -> &T {
+        self.get(k).expect("material compiled for every surface")
+    }
+}
+
 struct Ctx<'a> {
     rng: Rng,
+    /// Rays traced in this context (added to the tracer's total once, at the end).
+    rays: u64,
     tracked: &'a [bool],
     sink: Option<&'a mut dyn FnMut(Contribution)>,
 }
@@ -127,9 +162,9 @@ pub struct Tracer {
     surf_prim: Vec<usize>,
     /// Scene index of each BVH shape's material.
     surf_mat: Vec<usize>,
-    mats: HashMap<usize, Material>,
+    mats: Dense<Material>,
     /// Patterns modifying each material (nearest first).
-    patterns: HashMap<usize, Vec<crate::pattern::Pattern>>,
+    patterns: Dense<Vec<crate::pattern::Pattern>>,
     /// Scene index of the direct modifier of every primitive.
     modifier_of: Vec<Option<usize>>,
     distant: Vec<Distant>,
@@ -150,11 +185,11 @@ impl Tracer {
         let mut shapes = Vec::new();
         let mut surf_prim = Vec::new();
         let mut surf_mat = Vec::new();
-        let mut mats: HashMap<usize, Material> = HashMap::new();
+        let mut mats: Dense<Material> = Dense::default();
         let mut distant = Vec::new();
         let mut warnings = Vec::new();
-        let mut patterns: HashMap<usize, Vec<crate::pattern::Pattern>> = HashMap::new();
-        let mut need_mat = |m: usize, mats: &mut HashMap<usize, Material>| -> Result<()> {
+        let mut patterns: Dense<Vec<crate::pattern::Pattern>> = Dense::default();
+        let mut need_mat = |m: usize, mats: &mut Dense<Material>| -> Result<()> {
             if mats.contains_key(&m) {
                 return Ok(());
             }
@@ -482,6 +517,7 @@ impl Tracer {
     pub fn radiance(&self, ray_index: u64, org: DVec3, dir: DVec3) -> [f64; 3] {
         let mut cx = Ctx {
             rng: Rng::for_ray(self.opts.seed, ray_index),
+            rays: 0,
             tracked: &[],
             sink: None,
         };
@@ -489,13 +525,16 @@ impl Tracer {
         if d == DVec3::ZERO {
             return [0.0; 3];
         }
-        self.trace(&Self::primary(org, d), &mut cx).to_array()
+        let v = self.trace(&Self::primary(org, d), &mut cx);
+        self.count(&cx);
+        v.to_array()
     }
 
     /// Irradiance at `point` on a surface facing `normal` (rtrace `-I`).
     pub fn irradiance(&self, ray_index: u64, point: DVec3, normal: DVec3) -> [f64; 3] {
         let mut cx = Ctx {
             rng: Rng::for_ray(self.opts.seed, ray_index),
+            rays: 0,
             tracked: &[],
             sink: None,
         };
@@ -503,7 +542,9 @@ impl Tracer {
         if n == DVec3::ZERO {
             return [0.0; 3];
         }
-        self.irradiance_in(point, n, &mut cx).to_array()
+        let v = self.irradiance_in(point, n, &mut cx);
+        self.count(&cx);
+        v.to_array()
     }
 
     /// Traces a ray and reports every ray that reaches a surface whose direct modifier
@@ -522,10 +563,13 @@ impl Tracer {
         }
         let mut cx = Ctx {
             rng: Rng::for_ray(self.opts.seed, ray_index),
+            rays: 0,
             tracked,
             sink: Some(sink),
         };
-        self.trace(&Self::primary(org, d), &mut cx).to_array()
+        let v = self.trace(&Self::primary(org, d), &mut cx);
+        self.count(&cx);
+        v.to_array()
     }
 
     /// As [`contributions`](Self::contributions) for an irradiance request (`-I+`):
@@ -544,10 +588,18 @@ impl Tracer {
         }
         let mut cx = Ctx {
             rng: Rng::for_ray(self.opts.seed, ray_index),
+            rays: 0,
             tracked,
             sink: Some(sink),
         };
-        self.irradiance_in(point, n, &mut cx).to_array()
+        let v = self.irradiance_in(point, n, &mut cx);
+        self.count(&cx);
+        v.to_array()
+    }
+
+    fn count(&self, cx: &Ctx) {
+        self.rays
+            .fetch_add(cx.rays, std::sync::atomic::Ordering::Relaxed);
     }
 
     fn irradiance_in(&self, p: DVec3, n: DVec3, cx: &mut Ctx) -> DVec3 {
@@ -675,7 +727,7 @@ impl Tracer {
     }
 
     fn trace(&self, r: &Ray, cx: &mut Ctx) -> DVec3 {
-        self.rays.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        cx.rays += 1;
         let tmin = Self::tmin(r.org);
         if self.effects.occlusion_shadows && r.flags & SHADOW != 0 {
             if let Some(s) = r.src {
