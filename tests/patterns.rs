@@ -107,7 +107,10 @@ fn pattern_errors_are_clear() {
     let cases = [
         ("void brightfunc b 2 f p.cal 0 0\nb glow g 0 0 4 1 1 1 0\ng source s 0 0 4 0 0 1 180\n", "nosuchname"),
         ("void brightfunc b 2 f missing.cal 0 0\nb glow g 0 0 4 1 1 1 0\ng source s 0 0 4 0 0 1 180\n", "missing.cal"),
-        ("void brightfunc b 4 f p.cal -rz 90 0 0\nb glow g 0 0 4 1 1 1 0\ng source s 0 0 4 0 0 1 180\n", "transform"),
+        // Radiance ignores words after a pattern's transform that are not transform options;
+        // fenestra reports them.
+        ("void brightfunc b 4 f p.cal -bogus 90 0 0\nb glow g 0 0 4 1 1 1 0\ng source s 0 0 4 0 0 1 180\n", "-bogus"),
+        ("void brightfunc b 4 f p.cal -s 0 0 0\nb glow g 0 0 4 1 1 1 0\ng source s 0 0 4 0 0 1 180\n", "singular"),
     ];
     for (k, (text, what)) in cases.iter().enumerate() {
         std::fs::write(dir.join("s.rad"), text).unwrap();
@@ -120,6 +123,72 @@ fn pattern_errors_are_clear() {
         assert!(
             err.contains(what) && err.contains("s.rad:1"),
             "case {k}: {err}"
+        );
+    }
+}
+
+/// Transform arguments after a pattern's strings: every ray variable in the pattern's
+/// frame (`D N P T Ts Rdot S Tx Ty Tz I J K`) for a rotated, translated and scaled frame,
+/// a negative scale, and a mirror with a repeated group, plus a brightdata pattern with a
+/// transform, against the reference rtrace.
+#[test]
+fn oracle_pattern_transforms_match_rtrace() {
+    let Some(oracle) = common::oracle() else {
+        return;
+    };
+    let dir = common::scratch("patterns_xf");
+    std::fs::write(dir.join("ramp.dat"), "1\n-3 3 5\n1 2 4 3 2.5\n").unwrap();
+    let vars = [
+        "Dx", "Dy", "Dz", "Nx", "Ny", "Nz", "Px", "Py", "Pz", "T", "Ts", "Rdot", "S", "Tx", "Ty",
+        "Tz", "Ix", "Iy", "Iz", "Jx", "Jy", "Jz", "Kx", "Ky", "Kz",
+    ];
+    let rays = "0.3 0.2 2 0.1 0.2 -1\n-1 0.5 3 0.3 -0.1 -1\n2 -1 1 -0.4 0.3 -1\n";
+    for xf in ["-rz 30 -t 1 2 3 -s 2 -rx 20", "-s -2", "-mx -i 2 -rz 10"] {
+        let nxf = xf.split_whitespace().count();
+        for (k, chunk) in vars.chunks(3).enumerate() {
+            let mut cal = String::new();
+            for c in 0..3 {
+                // offset 10 keeps every value positive (rtrace prints colours, not signs)
+                cal.push_str(&format!("v{c} = {} + 10;\n", chunk.get(c).unwrap_or(&"0")));
+            }
+            std::fs::write(dir.join("xf.cal"), &cal).unwrap();
+            let scene = format!(
+                "void colorfunc pat {} v0 v1 v2 xf.cal {xf} 0 0\n\
+                 pat glow g 0 0 4 1 1 1 0\n\
+                 g polygon floor 0 0 12  -5 -5 0  5 -5 0  5 5 0  -5 5 0\n",
+                4 + nxf
+            );
+            std::fs::write(dir.join("scene.rad"), scene).unwrap();
+            let (t, o) = both_rtrace(&oracle, &dir, &["-h", "-ab", "0", "-u-"], rays);
+            assert_eq!(t.len(), 9);
+            for (j, (a, b)) in t.iter().zip(&o).enumerate() {
+                // 6 printed digits; single-precision colours in Radiance.
+                assert!(
+                    (a - b).abs() <= 2e-5 * a.abs().max(1e-3),
+                    "{xf}: {} on ray {}: oracle {a} ours {b}",
+                    chunk.get(j % 3).unwrap_or(&"0"),
+                    j / 3
+                );
+            }
+        }
+    }
+    let scene = "void brightdata ramp 10 noneg ramp.dat . Px -rz 30 -t 1 0 0\n0\n0\n\
+                 ramp glow g 0 0 4 1 1 1 0\ng polygon floor 0 0 12  -5 -5 0  5 -5 0  5 5 0  -5 5 0\n";
+    std::fs::write(dir.join("scene.rad"), scene).unwrap();
+    let mut rays = String::new();
+    for k in 0..20 {
+        rays.push_str(&format!(
+            "{} {} 1 0 0 -1\n",
+            k as f64 * 0.4 - 4.0,
+            k as f64 * 0.2 - 2.0
+        ));
+    }
+    let (t, o) = both_rtrace(&oracle, &dir, &["-h", "-ab", "0", "-u-"], &rays);
+    assert_eq!(t.len(), 60);
+    for (k, (a, b)) in t.iter().zip(&o).enumerate() {
+        assert!(
+            (a - b).abs() <= 2e-5 * a.abs().max(1e-3),
+            "brightdata, value {k}: oracle {a} ours {b}"
         );
     }
 }

@@ -89,6 +89,37 @@ impl Transform {
         o
     }
 
+    /// The inverse transform (scale `1/sca`); `None` when the matrix is singular (`-s 0`).
+    pub fn inverse(&self) -> Option<Transform> {
+        let a = &self.m;
+        let cof = |r0: usize, r1: usize, c0: usize, c1: usize| {
+            a[r0][c0] * a[r1][c1] - a[r0][c1] * a[r1][c0]
+        };
+        let det = a[0][0] * cof(1, 2, 1, 2) - a[0][1] * cof(1, 2, 0, 2) + a[0][2] * cof(1, 2, 0, 1);
+        if det == 0.0 || !det.is_finite() || self.sca == 0.0 {
+            return None;
+        }
+        // Inverse of the 3×3 linear part (adjugate / determinant).
+        let mut inv = IDENTITY;
+        inv[0][0] = cof(1, 2, 1, 2) / det;
+        inv[0][1] = -cof(0, 2, 1, 2) / det;
+        inv[0][2] = cof(0, 1, 1, 2) / det;
+        inv[1][0] = -cof(1, 2, 0, 2) / det;
+        inv[1][1] = cof(0, 2, 0, 2) / det;
+        inv[1][2] = -cof(0, 1, 0, 2) / det;
+        inv[2][0] = cof(1, 2, 0, 1) / det;
+        inv[2][1] = -cof(0, 2, 0, 1) / det;
+        inv[2][2] = cof(0, 1, 0, 1) / det;
+        // p = (p' − t)·A⁻¹: the translation row is −t·A⁻¹.
+        for j in 0..3 {
+            inv[3][j] = -(a[3][0] * inv[0][j] + a[3][1] * inv[1][j] + a[3][2] * inv[2][j]);
+        }
+        Some(Transform {
+            m: inv,
+            sca: 1.0 / self.sca,
+        })
+    }
+
     /// Parses transform options from the start of `args` (`-t`, `-rx`, `-ry`, `-rz`, `-s`,
     /// `-mx`, `-my`, `-mz`, `-i N`), stopping at the first word that is not one of them.
     /// Returns the transform and the number of words used.
@@ -197,6 +228,26 @@ fn repeat(total: &Transform, group: &Transform, reps: i64) -> Transform {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn inverse_undoes_the_transform() {
+        let args: Vec<String> = "-rz 30 -t 1 2 3 -s 2 -rx 20 -my"
+            .split_whitespace()
+            .map(String::from)
+            .collect();
+        let f = Transform::parse_all(&args).unwrap();
+        let b = f.inverse().unwrap();
+        assert!((b.sca * f.sca - 1.0).abs() < 1e-15);
+        let p = [0.3, -1.7, 2.5];
+        let q = b.point(f.point(p));
+        let v = b.vector(f.vector(p));
+        for k in 0..3 {
+            assert!((q[k] - p[k]).abs() < 1e-12, "{q:?}");
+            assert!((v[k] - p[k]).abs() < 1e-12, "{v:?}");
+        }
+        let zero: Vec<String> = ["-s", "0"].iter().map(|s| s.to_string()).collect();
+        assert!(Transform::parse_all(&zero).unwrap().inverse().is_none());
+    }
 
     fn w(s: &str) -> Vec<String> {
         s.split_whitespace().map(String::from).collect()

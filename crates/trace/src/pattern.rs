@@ -32,10 +32,41 @@ pub struct PatternInput {
 }
 
 /// The names the host sets before each evaluation, in this order.
-const HOST_VARS: [&str; 28] = [
+const HOST_VARS: [&str; 29] = [
     "Dx", "Dy", "Dz", "Nx", "Ny", "Nz", "Px", "Py", "Pz", "T", "Ts", "Rdot", "NxP", "NyP", "NzP",
-    "RdotP", "S", "Ix", "Iy", "Iz", "Jx", "Jy", "Jz", "Kx", "Ky", "Kz", "Tx", "Ty",
+    "RdotP", "S", "Ix", "Iy", "Iz", "Jx", "Jy", "Jz", "Kx", "Ky", "Kz", "Tx", "Ty", "Tz",
 ];
+
+/// The coordinate frame of a pattern given transform arguments (`-rz 30 -t 1 2 3 …`
+/// after its strings), as Radiance's renderers set it: points go through the inverse
+/// transform `b`; directions and normals through its linear part divided by the scale
+/// `s = |1/sca|` (so they stay unit); distances are multiplied by `s`; `S` is `s`,
+/// `Tx Ty Tz` the inverse's translation and `I J K` its rows over `s` (checked against
+/// the reference rtrace in tests/patterns.rs).
+#[derive(Debug, Clone, Copy)]
+pub struct PatternFrame {
+    b: fenestra_scene::transform::Transform,
+    s: f64,
+}
+
+impl PatternFrame {
+    /// The frame of transform words `args` (`None` for none); an error names a bad word or
+    /// a singular transform.
+    pub fn parse(args: &[String]) -> Result<Option<PatternFrame>> {
+        if args.is_empty() {
+            return Ok(None);
+        }
+        let f = fenestra_scene::transform::Transform::parse_all(args)?;
+        let b = f
+            .inverse()
+            .ok_or_else(|| anyhow!("the transform '{}' is singular", args.join(" ")))?;
+        Ok(Some(PatternFrame { b, s: b.sca.abs() }))
+    }
+
+    fn vector(&self, v: DVec3) -> DVec3 {
+        DVec3::from_array(self.b.vector(v.to_array())) / self.s
+    }
+}
 
 /// A trial ray evaluated when a pattern is compiled, so undefined names and wrong
 /// argument counts are reported at load time instead of as silent zeros later.
@@ -95,6 +126,7 @@ fn with_state<R>(id: u64, exe: &Compiled, f: impl FnOnce(&mut fenestra_calc::Sta
 pub struct CalPattern {
     exe: Compiled,
     id: u64,
+    frame: Option<PatternFrame>,
     vars: Vec<VarId>,
     exprs: Vec<ExprId>,
     fargs: Vec<f64>,
@@ -117,6 +149,7 @@ impl CalPattern {
         exprs: &[String],
         cal: &str,
         fargs: &[f64],
+        frame: Option<PatternFrame>,
         label: &str,
         user: &[CalSource],
     ) -> Result<CalPattern> {
@@ -130,6 +163,7 @@ impl CalPattern {
         let cp = CalPattern {
             exe,
             id: NEXT_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
+            frame,
             vars,
             exprs: ids,
             fargs: fargs.to_vec(),
@@ -143,18 +177,56 @@ impl CalPattern {
         self.eval(q)
     }
 
-    fn values(q: &PatternInput) -> [f64; 28] {
-        let (d, p, n) = (q.dir, q.point, q.normal);
-        let rdot = -d.dot(n);
+    fn values(q: &PatternInput, frame: Option<&PatternFrame>) -> [f64; 29] {
+        let rdot = -q.dir.dot(q.normal);
+        let Some(f) = frame else {
+            let (d, p, n) = (q.dir, q.point, q.normal);
+            return [
+                d.x, d.y, d.z, n.x, n.y, n.z, p.x, p.y, p.z, q.dist, q.dist, rdot, n.x, n.y, n.z,
+                rdot, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0,
+            ];
+        };
+        let (d, n) = (f.vector(q.dir), f.vector(q.normal));
+        let p = f.b.point(q.point.to_array());
+        let m = &f.b.m;
+        let t = q.dist * f.s;
+        let ax = |r: usize, c: usize| m[r][c] / f.s;
         [
-            d.x, d.y, d.z, n.x, n.y, n.z, p.x, p.y, p.z, q.dist, q.dist, rdot, n.x, n.y, n.z, rdot,
-            1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0,
+            d.x,
+            d.y,
+            d.z,
+            n.x,
+            n.y,
+            n.z,
+            p[0],
+            p[1],
+            p[2],
+            t,
+            t,
+            rdot,
+            n.x,
+            n.y,
+            n.z,
+            rdot,
+            f.s,
+            ax(0, 0),
+            ax(0, 1),
+            ax(0, 2),
+            ax(1, 0),
+            ax(1, 1),
+            ax(1, 2),
+            ax(2, 0),
+            ax(2, 1),
+            ax(2, 2),
+            m[3][0],
+            m[3][1],
+            m[3][2],
         ]
     }
 
     fn eval(&self, q: &PatternInput) -> Result<DVec3> {
         with_state(self.id, &self.exe, |st| {
-            st.set_all(&self.vars, &Self::values(q));
+            st.set_all(&self.vars, &Self::values(q, self.frame.as_ref()));
             st.set_fargs(&self.fargs);
             let mut out = [0.0; 3];
             for (k, e) in self.exprs.iter().enumerate() {
@@ -187,6 +259,7 @@ pub enum Pattern {
 pub struct DataPattern {
     exe: Compiled,
     id: u64,
+    frame: Option<PatternFrame>,
     vars: Vec<VarId>,
     coords: Vec<ExprId>,
     funcs: Vec<FuncId>,
@@ -206,7 +279,7 @@ impl std::fmt::Debug for DataPattern {
 impl DataPattern {
     fn eval(&self, q: &PatternInput) -> Result<DVec3> {
         with_state(self.id, &self.exe, |st| {
-            st.set_all(&self.vars, &CalPattern::values(q));
+            st.set_all(&self.vars, &CalPattern::values(q, self.frame.as_ref()));
             st.set_fargs(&self.fargs);
             let mut x = [0.0f64; 16];
             for (k, e) in self.coords.iter().enumerate() {
@@ -279,11 +352,16 @@ pub fn compile(scene: &Scene, k: usize, user: &str, cal: &[CalSource]) -> Result
             if nexpr > 1 { "s" } else { "" }
         );
     }
-    if q.sargs.len() > nexpr + 1 {
-        bail!("{what}: transform arguments on patterns are not supported yet");
-    }
-    let cp = CalPattern::new(&q.sargs[..nexpr], &q.sargs[nexpr], &q.rargs, &q.name, cal)
-        .map_err(|e| anyhow!("{what}: {e:#}"))?;
+    let frame = PatternFrame::parse(&q.sargs[nexpr + 1..]).map_err(|e| anyhow!("{what}: {e:#}"))?;
+    let cp = CalPattern::new(
+        &q.sargs[..nexpr],
+        &q.sargs[nexpr],
+        &q.rargs,
+        frame,
+        &q.name,
+        cal,
+    )
+    .map_err(|e| anyhow!("{what}: {e:#}"))?;
     Ok(Pattern::Cal(Arc::new(cp)))
 }
 
@@ -311,9 +389,8 @@ fn compile_data(q: &fenestra_scene::Primitive, what: &str, user: &[CalSource]) -
             coords.len()
         );
     }
-    if coords.len() > dims {
-        bail!("{what}: transform arguments on patterns are not supported yet");
-    }
+    let (coords, xf) = coords.split_at(dims);
+    let frame = PatternFrame::parse(xf).map_err(|e| anyhow!("{what}: {e:#}"))?;
     let mut p = program(user, cal).map_err(|e| anyhow!("{what}: {e:#}"))?;
     let vars = p.bind_vars(&HOST_VARS);
     let mut ids = Vec::new();
@@ -330,6 +407,7 @@ fn compile_data(q: &fenestra_scene::Primitive, what: &str, user: &[CalSource]) -
     let dp = DataPattern {
         exe,
         id: NEXT_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
+        frame,
         vars,
         coords: ids,
         funcs,
