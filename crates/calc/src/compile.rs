@@ -86,6 +86,7 @@ impl Program {
             chans,
             exprs,
             errors: c.errors,
+            fast: Vec::new(),
         };
         let bad = crate::fold::fold(&mut out);
         if let Some(&i) = bad.first() {
@@ -95,6 +96,10 @@ impl Program {
                     format!("{}: bad constant expression", out.var_names[i]),
                 ));
             }
+        }
+        // FENESTRA_CALC_EXACT=1 leaves out the fast code (for comparisons and timing)
+        if std::env::var_os("FENESTRA_CALC_EXACT").is_none_or(|v| v.is_empty() || v == "0") {
+            out.build_fast();
         }
         Ok(out)
     }

@@ -7,6 +7,7 @@ use std::cell::Cell;
 
 use crate::builtins::{self, Builtin};
 use crate::error::{CalcError, ErrorKind};
+use crate::fast::{Fast, Inputs};
 use crate::node::{FnTarget, Node};
 use crate::program::{ExprId, FuncId, HostFn, VarId};
 
@@ -50,6 +51,9 @@ pub struct Compiled {
     pub(crate) chans: Vec<(u32, Node)>,
     pub(crate) exprs: Vec<Node>,
     pub(crate) errors: Vec<CalcError>,
+    /// Fast code per root (see `crate::fast`): variables, then channels (in the order
+    /// of `chans`), then standalone expressions; `None` where a root has none.
+    pub(crate) fast: Vec<Option<Fast>>,
 }
 
 /// Warnings Radiance prints while evaluating (counted; the host reports them).
@@ -124,6 +128,18 @@ pub struct State {
     errno: ErrFlag,
     /// Counts writes of the error flag (to know whether an evaluation touched it).
     errno_writes: u64,
+    /// Register files of the fast code, one per root.
+    fast_regs: Vec<Vec<f64>>,
+    /// The epoch in which the roots of `fast_roots` were evaluated by fast code.
+    fast_epoch: u64,
+    /// Roots evaluated by fast code in `fast_epoch` and not yet replayed exactly.
+    fast_roots: Vec<u32>,
+    /// The last epoch with an exact evaluation: no fast code for the rest of it (the
+    /// exact evaluator may have cached values that a recomputation would not give).
+    exact_epoch: u64,
+    /// Evaluations done by fast code (for tests).
+    #[cfg(test)]
+    pub(crate) fast_hits: u64,
 }
 
 pub(crate) struct Frame<'a> {
@@ -238,7 +254,87 @@ impl Compiled {
             warnings: Warnings::default(),
             errno: ErrFlag::None,
             errno_writes: 0,
+            fast_regs: self
+                .fast
+                .iter()
+                .map(|f| f.as_ref().map(|f| f.regs.clone()).unwrap_or_default())
+                .collect(),
+            fast_epoch: 0,
+            fast_roots: Vec::new(),
+            exact_epoch: 0,
+            #[cfg(test)]
+            fast_hits: 0,
         }
+    }
+
+    /// Builds the fast code of every root (after folding).
+    pub(crate) fn build_fast(&mut self) {
+        let mut fast = Vec::new();
+        for v in &self.vars {
+            fast.push(match v {
+                // a `:` variable keeps its first value: always exact (it is cached)
+                VarSlot::Def(n, false) => crate::fast::build(self, n),
+                _ => None,
+            });
+        }
+        for (_, n) in &self.chans {
+            fast.push(crate::fast::build(self, n));
+        }
+        for n in &self.exprs {
+            fast.push(crate::fast::build(self, n));
+        }
+        self.fast = fast;
+    }
+
+    /// Tries the fast code of root `id`; `None` when there is none or it gave up.
+    #[inline]
+    fn try_fast(&self, st: &mut State, id: usize) -> Option<f64> {
+        let f = self.fast.get(id)?.as_ref()?;
+        if st.exact_epoch == st.epoch {
+            return None;
+        }
+        let inp = Inputs {
+            vals: &st.vals,
+            stamps: &st.stamps,
+            chans: &st.chans,
+            fargs: &st.fargs,
+        };
+        let x = f.run(&mut st.fast_regs[id], &inp)?;
+        if st.fast_epoch != st.epoch {
+            st.fast_epoch = st.epoch;
+            st.fast_roots.clear();
+        }
+        st.fast_roots.push(id as u32);
+        #[cfg(test)]
+        {
+            st.fast_hits += 1;
+        }
+        Some(x)
+    }
+
+    /// Before an exact evaluation: the roots evaluated by fast code in this epoch are
+    /// evaluated again exactly (they raised nothing, so this only leaves the caches of
+    /// `=` variables and the error flag as the exact evaluator would have them).
+    fn replay(&self, st: &mut State) {
+        st.exact_epoch = st.epoch;
+        if st.fast_epoch != st.epoch || st.fast_roots.is_empty() {
+            return;
+        }
+        let roots = std::mem::take(&mut st.fast_roots);
+        let (nv, nc) = (self.vars.len(), self.chans.len());
+        for &id in &roots {
+            let id = id as usize;
+            if id < nv {
+                self.var_value(id as u32, st);
+            } else if id < nv + nc {
+                self.eval(&self.chans[id - nv].1, st, &ROOT);
+            } else {
+                self.eval(&self.exprs[id - nv - nc], st, &ROOT);
+            }
+            st.depth = 0;
+        }
+        st.fast_roots = roots;
+        st.fast_roots.clear();
     }
 
     /// The id of a variable (host-bound or defined), if it exists.
@@ -287,6 +383,10 @@ impl Compiled {
     /// Evaluates a variable.
     #[inline]
     pub fn eval_var(&self, st: &mut State, v: VarId) -> Result<f64, CalcError> {
+        if let Some(x) = self.try_fast(st, v.0 as usize) {
+            return Ok(x);
+        }
+        self.replay(st);
         let x = self.var_value(v.0, st);
         if st.fail.is_none() {
             return Ok(x);
@@ -309,6 +409,7 @@ impl Compiled {
                 ),
             ));
         }
+        self.replay(st);
         let fr = Frame::with_values(args);
         let x = self.eval(&fb.body, st, &fr);
         if st.fail.is_none() {
@@ -319,16 +420,25 @@ impl Compiled {
 
     /// Evaluates output channel `$n` (0 when it is not defined).
     pub fn eval_chan(&self, st: &mut State, n: u32) -> Result<f64, CalcError> {
-        let Some((_, node)) = self.chans.iter().find(|(c, _)| *c == n) else {
+        let Some(k) = self.chans.iter().position(|(c, _)| *c == n) else {
             return Ok(0.0);
         };
-        let x = self.eval(node, st, &ROOT);
+        if let Some(x) = self.try_fast(st, self.vars.len() + k) {
+            return Ok(x);
+        }
+        self.replay(st);
+        let x = self.eval(&self.chans[k].1, st, &ROOT);
         self.finish(st, x)
     }
 
     /// Evaluates a standalone expression added with [`crate::Program::add_expr`].
     #[inline]
     pub fn eval_expr(&self, st: &mut State, e: ExprId) -> Result<f64, CalcError> {
+        let id = self.vars.len() + self.chans.len() + e.0 as usize;
+        if let Some(x) = self.try_fast(st, id) {
+            return Ok(x);
+        }
+        self.replay(st);
         let x = self.eval(&self.exprs[e.0 as usize], st, &ROOT);
         if st.fail.is_none() {
             return Ok(x);

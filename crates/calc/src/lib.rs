@@ -19,6 +19,7 @@ pub mod builtins;
 mod compile;
 pub mod error;
 mod eval;
+mod fast;
 mod fold;
 pub mod format;
 mod lit;
