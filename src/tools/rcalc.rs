@@ -5,7 +5,7 @@ use std::io::{BufRead, Read, Write};
 use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
-use fenestra_calc::format::fmt_g;
+use fenestra_calc::format::push_g;
 use fenestra_calc::{Compiled, Program, State, VarId};
 use fenestra_cli::opts::{Item, Kind, Opt, Spec};
 
@@ -103,74 +103,365 @@ pub fn atof(w: &str) -> f64 {
     w[..end].parse().unwrap_or(0.0)
 }
 
-struct Run {
-    exe: Compiled,
+/// How a record's output line is produced: one per thread.
+struct Eval<'c> {
+    exe: &'c Compiled,
     st: State,
-    outs: Vec<Option<usize>>, // channel n-1 → index in chan list
+    /// Whether output channel `k + 1` is defined.
+    outs: &'c [bool],
     cond: Option<VarId>,
-    recno: VarId,
-    outno: VarId,
+    /// `recno` and `outno`, set before each record (`None`: no definition uses them).
+    counters: Option<(VarId, VarId)>,
     nout: u64,
     nrec: u64,
     ofmt: Fmt,
-    sep: String,
-    flush: bool,
+    sep: &'c [u8],
     warn: bool,
-    line: String,
+    /// Warning messages of the records evaluated, in order (printed by the caller).
+    warnings: Vec<String>,
+    scratch: String,
 }
 
-impl Run {
-    fn record(&mut self, out: &mut dyn Write) -> Result<()> {
+impl Eval<'_> {
+    /// Evaluates one record (channels already set) and appends its output to `out`.
+    fn record(&mut self, out: &mut Vec<u8>) -> Result<()> {
         self.nrec += 1;
-        self.st.set(self.recno, self.nrec as f64);
-        self.st.set(self.outno, (self.nout + 1) as f64);
+        if let Some((recno, outno)) = self.counters {
+            self.st.set(recno, self.nrec as f64);
+            self.st.set(outno, (self.nout + 1) as f64);
+        }
         if let Some(c) = self.cond {
             let v = self.exe.eval_var(&mut self.st, c)?;
             if v <= 0.0 {
-                self.report_warnings();
+                self.take_warnings();
                 return Ok(());
             }
         }
         self.nout += 1;
-        self.line.clear();
-        for (k, slot) in self.outs.iter().enumerate() {
-            let n = k as u32 + 1;
-            let v = match slot {
-                Some(_) => Some(self.exe.eval_chan(&mut self.st, n)?),
-                None => None,
+        let mark = out.len();
+        for (k, &defined) in self.outs.iter().enumerate() {
+            let v = if defined {
+                match self.exe.eval_chan(&mut self.st, k as u32 + 1) {
+                    Ok(v) => Some(v),
+                    Err(e) => {
+                        out.truncate(mark);
+                        return Err(e.into());
+                    }
+                }
+            } else {
+                None
             };
             match self.ofmt {
                 Fmt::Ascii => {
                     if k > 0 {
-                        self.line.push_str(&self.sep);
+                        out.extend_from_slice(self.sep);
                     }
                     if let Some(v) = v {
-                        self.line.push_str(&fmt_g(v, 9));
+                        push_g(out, v, 9, &mut self.scratch);
                     }
                 }
-                Fmt::Float => out.write_all(&(v.unwrap_or(0.0) as f32).to_ne_bytes())?,
-                Fmt::Double => out.write_all(&v.unwrap_or(0.0).to_ne_bytes())?,
+                Fmt::Float => out.extend_from_slice(&(v.unwrap_or(0.0) as f32).to_ne_bytes()),
+                Fmt::Double => out.extend_from_slice(&v.unwrap_or(0.0).to_ne_bytes()),
             }
         }
         if self.ofmt == Fmt::Ascii {
-            self.line.push('\n');
-            out.write_all(self.line.as_bytes())?;
+            out.push(b'\n');
         }
-        self.report_warnings();
-        if self.flush {
-            out.flush()?;
-        }
+        self.take_warnings();
         Ok(())
     }
 
-    fn report_warnings(&mut self) {
+    fn take_warnings(&mut self) {
         let w = self.st.take_warnings();
         if self.warn && w.any() {
-            for m in w.messages() {
-                fenestra_cli::warn(m);
-            }
+            self.warnings.extend(w.messages());
         }
     }
+
+    fn print_warnings(&mut self) {
+        for m in self.warnings.drain(..) {
+            fenestra_cli::warn(m);
+        }
+    }
+}
+
+/// How input records are delimited.
+#[derive(Clone, Copy)]
+enum Framing {
+    /// Lines of words (split at white space, or at a separator character).
+    Ascii { sep: Option<char>, count: usize },
+    /// Fixed-size records of `n` float32 (`size` 4) or float64 (`size` 8) values.
+    Binary { n: usize, size: usize },
+}
+
+/// `u8::is_ascii_whitespace`, the white space of `str::split_ascii_whitespace`.
+#[inline]
+fn is_ws(b: u8) -> bool {
+    matches!(b, b' ' | b'\t' | b'\n' | b'\x0C' | b'\r')
+}
+
+/// Powers of ten exactly representable as f64.
+const POW10: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+];
+
+/// A plain decimal word (`[+-]digits[.digits]`) whose digits fit in 53 bits: its
+/// value as one correctly rounded division of two exact numbers (the same value as
+/// `str::parse`); `None` for anything else.
+#[inline]
+fn parse_plain(w: &[u8]) -> Option<f64> {
+    let (neg, mut i) = match w.first() {
+        Some(b'-') => (true, 1),
+        Some(b'+') => (false, 1),
+        _ => (false, 0),
+    };
+    let (mut m, mut nd, mut frac) = (0u64, 0u32, 0usize);
+    while let Some(&c) = w.get(i) {
+        if !c.is_ascii_digit() {
+            break;
+        }
+        m = m * 10 + u64::from(c - b'0');
+        nd += 1;
+        if nd > 18 {
+            return None;
+        }
+        i += 1;
+    }
+    if w.get(i) == Some(&b'.') {
+        i += 1;
+        while let Some(&c) = w.get(i) {
+            if !c.is_ascii_digit() {
+                break;
+            }
+            m = m * 10 + u64::from(c - b'0');
+            nd += 1;
+            frac += 1;
+            if nd > 18 {
+                return None;
+            }
+            i += 1;
+        }
+    }
+    if nd == 0 || i != w.len() || m > 1 << 53 || frac >= POW10.len() {
+        return None;
+    }
+    let v = m as f64 / POW10[frac];
+    Some(if neg { -v } else { v })
+}
+
+/// A word's value as C's `atof` reads it (see [`atof`]).
+fn word_value(w: &[u8]) -> Result<f64> {
+    if let Some(v) = parse_plain(w) {
+        return Ok(v);
+    }
+    let s = std::str::from_utf8(w)
+        .map_err(|_| anyhow::anyhow!("stream did not contain valid UTF-8"))?;
+    Ok(atof(s))
+}
+
+/// The columns of one input line (without its newline).
+fn line_cols(line: &[u8], sep: Option<char>, count: usize, cols: &mut Vec<f64>) -> Result<()> {
+    let mut end = line.len();
+    while end > 0 && line[end - 1] == b'\r' {
+        end -= 1;
+    }
+    let line = &line[..end];
+    cols.clear();
+    match sep {
+        None => {
+            let mut i = 0;
+            while i < line.len() {
+                while i < line.len() && is_ws(line[i]) {
+                    i += 1;
+                }
+                let s = i;
+                while i < line.len() && !is_ws(line[i]) {
+                    i += 1;
+                }
+                if i > s {
+                    cols.push(word_value(&line[s..i])?);
+                }
+            }
+        }
+        Some(c) => {
+            let text = std::str::from_utf8(line)
+                .map_err(|_| anyhow::anyhow!("stream did not contain valid UTF-8"))?;
+            cols.extend(text.split(c).map(atof));
+        }
+    }
+    if count > 0 {
+        cols.truncate(count);
+    }
+    Ok(())
+}
+
+/// What a block of input gave: its output, the warnings in order, and the error that
+/// stopped it (after the output of the records before).
+struct Done {
+    out: Vec<u8>,
+    warnings: Vec<String>,
+    err: Option<anyhow::Error>,
+}
+
+/// Evaluates the records of a block of whole records.
+fn eval_block(ev: &mut Eval, framing: Framing, fname: &str, block: &[u8], last: bool) -> Done {
+    let mut out = Vec::with_capacity(block.len() / 2);
+    let mut cols = Vec::new();
+    let err = (|| -> Result<()> {
+        match framing {
+            Framing::Ascii { sep, count } => {
+                for line in block.split_inclusive(|&b| b == b'\n') {
+                    let line = line.strip_suffix(b"\n").unwrap_or(line);
+                    line_cols(line, sep, count, &mut cols)
+                        .with_context(|| format!("reading {fname}"))?;
+                    ev.st.set_chans(&cols);
+                    ev.record(&mut out)?;
+                }
+            }
+            Framing::Binary { n, size } => {
+                let rec = n * size;
+                let whole = block.len() / rec * rec;
+                for r in block[..whole].chunks_exact(rec) {
+                    binary_cols(r, size, &mut cols);
+                    ev.st.set_chans(&cols);
+                    ev.record(&mut out)?;
+                }
+                if last && whole < block.len() {
+                    ev.warnings.push(format!(
+                        "{fname}: incomplete record at end of input ({} of {rec} bytes)",
+                        block.len() - whole
+                    ));
+                }
+            }
+        }
+        Ok(())
+    })()
+    .err();
+    Done {
+        out,
+        warnings: std::mem::take(&mut ev.warnings),
+        err,
+    }
+}
+
+fn binary_cols(r: &[u8], size: usize, cols: &mut Vec<f64>) {
+    cols.clear();
+    cols.extend(r.chunks_exact(size).map(|b| {
+        if size == 4 {
+            f32::from_ne_bytes(b.try_into().unwrap_or([0; 4])) as f64
+        } else {
+            f64::from_ne_bytes(b.try_into().unwrap_or([0; 8]))
+        }
+    }));
+}
+
+/// Size of the blocks of input evaluated in parallel.
+const BLOCK: usize = 1 << 18;
+
+/// Reads the next block of whole records (what is left of an incomplete one is kept
+/// in `carry`); an empty block at the end of the input.
+fn next_block(
+    input: &mut dyn Read,
+    framing: Framing,
+    carry: &mut Vec<u8>,
+) -> std::io::Result<(Vec<u8>, bool)> {
+    let mut block = Vec::with_capacity(BLOCK + carry.len() + 4096);
+    block.append(carry);
+    let want = BLOCK.max(block.len() + 4096);
+    let mut eof = false;
+    while block.len() < want {
+        let at = block.len();
+        block.resize(want, 0);
+        let k = loop {
+            match input.read(&mut block[at..]) {
+                Ok(k) => break k,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+                Err(e) => return Err(e),
+            }
+        };
+        block.truncate(at + k);
+        if k == 0 {
+            eof = true;
+            break;
+        }
+    }
+    if !eof {
+        let cut = match framing {
+            Framing::Ascii { .. } => block.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1),
+            Framing::Binary { n, size } => block.len() / (n * size) * (n * size),
+        };
+        carry.extend_from_slice(&block[cut..]);
+        block.truncate(cut);
+    }
+    Ok((block, eof))
+}
+
+/// Evaluates one input with `threads` evaluators on blocks of records, output in
+/// input order.
+fn run_parallel<'c>(
+    mk: &(dyn Fn() -> Eval<'c> + Sync),
+    framing: Framing,
+    fname: &str,
+    mut input: Box<dyn BufRead + Send>,
+    threads: usize,
+    out: &mut dyn Write,
+) -> Result<()> {
+    use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
+    type Block = std::result::Result<(Vec<u8>, bool), String>;
+    std::thread::scope(|sc| -> Result<()> {
+        let mut to_workers: Vec<SyncSender<Block>> = Vec::new();
+        let mut from_workers: Vec<Receiver<Done>> = Vec::new();
+        for _ in 0..threads {
+            let (btx, brx) = sync_channel::<Block>(2);
+            let (dtx, drx) = sync_channel::<Done>(2);
+            to_workers.push(btx);
+            from_workers.push(drx);
+            sc.spawn(move || {
+                let mut ev = mk();
+                while let Ok(b) = brx.recv() {
+                    let done = match b {
+                        Ok((block, last)) => eval_block(&mut ev, framing, fname, &block, last),
+                        Err(e) => Done {
+                            out: Vec::new(),
+                            warnings: Vec::new(),
+                            err: Some(anyhow::anyhow!("{e}")),
+                        },
+                    };
+                    let stop = done.err.is_some();
+                    if dtx.send(done).is_err() || stop {
+                        break;
+                    }
+                }
+            });
+        }
+        sc.spawn(move || {
+            let mut carry = Vec::new();
+            let mut i = 0usize;
+            loop {
+                let b = next_block(&mut input, framing, &mut carry)
+                    .map_err(|e| format!("reading {fname}: {e}"));
+                let end = !matches!(b, Ok((_, false)));
+                if to_workers[i % to_workers.len()].send(b).is_err() || end {
+                    break;
+                }
+                i += 1;
+            }
+        });
+        let mut i = 0usize;
+        while let Ok(done) = from_workers[i % threads].recv() {
+            out.write_all(&done.out)?;
+            for m in done.warnings {
+                fenestra_cli::warn(m);
+            }
+            if let Some(e) = done.err {
+                out.flush()?;
+                return Err(e);
+            }
+            i += 1;
+        }
+        Ok(())
+    })
 }
 
 /// Runs rcalc.
@@ -223,97 +514,149 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let ids = prog.bind_vars(&["recno", "outno"]);
     let exe = prog.compile().map_err(anyhow::Error::new)?;
     let maxchan = exe.channels().last().copied().unwrap_or(0) as usize;
-    let mut outs = vec![None; maxchan];
-    for (i, n) in exe.channels().iter().enumerate() {
-        outs[*n as usize - 1] = Some(i);
+    let mut outs = vec![false; maxchan];
+    for n in exe.channels() {
+        outs[n as usize - 1] = true;
     }
     let cond = exe.var("cond");
-    let st = exe.state();
-    let mut r = Run {
-        exe,
-        st,
-        outs,
+    let sep_out = sep.clone().unwrap_or_else(|| "\t".into());
+    let (recno, outno) = (ids[0], ids[1]);
+    // records are independent unless a definition counts them or a `:` constant keeps
+    // the value of the first record
+    let independent =
+        !exe.references_var(recno) && !exe.references_var(outno) && !exe.has_late_constants();
+    let mk = |counters: bool| Eval {
+        exe: &exe,
+        st: exe.state(),
+        outs: &outs,
         cond,
-        recno: ids[0],
-        outno: ids[1],
+        counters: counters.then_some((recno, outno)),
         nout: 0,
         nrec: 0,
         ofmt,
-        sep: sep.clone().unwrap_or_else(|| "\t".into()),
-        flush,
+        sep: sep_out.as_bytes(),
         warn,
-        line: String::new(),
+        warnings: Vec::new(),
+        scratch: String::new(),
     };
     let stdout = std::io::stdout();
-    let mut out = std::io::BufWriter::with_capacity(1 << 16, stdout.lock());
+    let mut out = stdout.lock();
     if noinput {
-        r.record(&mut out)?;
+        let mut ev = mk(true);
+        let mut buf = Vec::new();
+        let r = ev.record(&mut buf);
+        out.write_all(&buf)?;
         out.flush()?;
+        r?;
+        ev.print_warnings();
         return Ok(ExitCode::SUCCESS);
     }
     if files.is_empty() {
         files.push("-".into());
     }
-    let in_sep = sep.and_then(|s| s.chars().next());
+    let framing = match ifmt {
+        Fmt::Ascii => Framing::Ascii {
+            sep: sep.and_then(|s| s.chars().next()),
+            count: icount,
+        },
+        Fmt::Float => Framing::Binary {
+            n: icount.max(1),
+            size: 4,
+        },
+        Fmt::Double => Framing::Binary {
+            n: icount.max(1),
+            size: 8,
+        },
+    };
+    // FENESTRA_RCALC_THREADS: evaluator threads (1: one thread, records in turn)
+    let threads = std::env::var("FENESTRA_RCALC_THREADS")
+        .ok()
+        .and_then(|v| v.parse::<usize>().ok())
+        .unwrap_or_else(|| {
+            std::thread::available_parallelism()
+                .map_or(1, |n| n.get())
+                .min(4)
+        })
+        .max(1);
+    if threads > 1 && independent && !flush {
+        let mkp = || mk(false);
+        for f in &files {
+            let input = fenestra_cli::input::open(f)?;
+            run_parallel(&mkp, framing, f, input, threads, &mut out)?;
+        }
+        out.flush()?;
+        return Ok(ExitCode::SUCCESS);
+    }
+    let mut ev = mk(true);
+    let mut buf: Vec<u8> = Vec::with_capacity(1 << 17);
+    let mut cols: Vec<f64> = Vec::new();
     for f in &files {
         let mut input = fenestra_cli::input::open(f)?;
-        match ifmt {
-            Fmt::Ascii => {
-                let mut line = String::new();
-                let mut cols: Vec<f64> = Vec::new();
-                loop {
-                    line.clear();
-                    if input
-                        .read_line(&mut line)
-                        .with_context(|| format!("reading {f}"))?
-                        == 0
-                    {
-                        break;
-                    }
-                    let text = line.trim_end_matches(['\n', '\r']);
-                    cols.clear();
-                    match in_sep {
-                        Some(c) => cols.extend(text.split(c).map(atof)),
-                        None => cols.extend(text.split_ascii_whitespace().map(atof)),
-                    }
-                    if icount > 0 {
-                        cols.truncate(icount);
-                    }
-                    r.st.set_chans(&cols);
-                    r.record(&mut out)?;
-                }
-            }
-            Fmt::Float | Fmt::Double => {
-                let n = icount.max(1);
-                let size = if ifmt == Fmt::Float { 4 } else { 8 };
-                let mut buf = vec![0u8; n * size];
-                let mut cols = vec![0.0f64; n];
-                loop {
-                    match read_full(&mut input, &mut buf)? {
-                        0 => break,
-                        k if k < buf.len() => {
-                            fenestra_cli::warn(format!(
-                                "{f}: incomplete record at end of input ({k} of {} bytes)",
-                                buf.len()
-                            ));
+        let r = (|| -> Result<()> {
+            match framing {
+                Framing::Ascii { sep, count } => {
+                    let mut line = Vec::new();
+                    loop {
+                        line.clear();
+                        if input
+                            .read_until(b'\n', &mut line)
+                            .with_context(|| format!("reading {f}"))?
+                            == 0
+                        {
                             break;
                         }
-                        _ => {}
+                        let text = line.strip_suffix(b"\n").unwrap_or(&line);
+                        line_cols(text, sep, count, &mut cols)
+                            .with_context(|| format!("reading {f}"))?;
+                        ev.st.set_chans(&cols);
+                        ev.record(&mut buf)?;
+                        ev.print_warnings();
+                        if flush || buf.len() >= 1 << 16 {
+                            out.write_all(&buf)?;
+                            buf.clear();
+                            if flush {
+                                out.flush()?;
+                            }
+                        }
                     }
-                    for (i, c) in cols.iter_mut().enumerate() {
-                        let b = &buf[i * size..(i + 1) * size];
-                        *c = if size == 4 {
-                            f32::from_ne_bytes(b.try_into().unwrap_or([0; 4])) as f64
-                        } else {
-                            f64::from_ne_bytes(b.try_into().unwrap_or([0; 8]))
-                        };
+                }
+                Framing::Binary { n, size } => {
+                    let mut rec = vec![0u8; n * size];
+                    loop {
+                        match read_full(&mut input, &mut rec)? {
+                            0 => break,
+                            k if k < rec.len() => {
+                                fenestra_cli::warn(format!(
+                                    "{f}: incomplete record at end of input ({k} of {} bytes)",
+                                    rec.len()
+                                ));
+                                break;
+                            }
+                            _ => {}
+                        }
+                        binary_cols(&rec, size, &mut cols);
+                        ev.st.set_chans(&cols);
+                        ev.record(&mut buf)?;
+                        ev.print_warnings();
+                        if flush || buf.len() >= 1 << 16 {
+                            out.write_all(&buf)?;
+                            buf.clear();
+                            if flush {
+                                out.flush()?;
+                            }
+                        }
                     }
-                    r.st.set_chans(&cols);
-                    r.record(&mut out)?;
                 }
             }
+            Ok(())
+        })();
+        if let Err(e) = r {
+            out.write_all(&buf)?;
+            out.flush()?;
+            return Err(e);
         }
     }
+    out.write_all(&buf)?;
     out.flush()?;
     Ok(ExitCode::SUCCESS)
 }

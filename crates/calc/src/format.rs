@@ -29,6 +29,74 @@ pub fn fmt_g(x: f64, prec: usize) -> String {
     }
 }
 
+/// Appends `x` formatted like C's `%.{prec}g` (the same text as [`fmt_g`]) to `out`,
+/// without allocating when `out` and `scratch` have room.
+pub fn push_g(out: &mut Vec<u8>, x: f64, prec: usize, scratch: &mut String) {
+    use std::fmt::Write;
+    let p = prec.max(1);
+    if !x.is_finite() || x == 0.0 || p > 17 {
+        out.extend_from_slice(fmt_g(x, prec).as_bytes());
+        return;
+    }
+    if x.fract() == 0.0 && x.abs() < 10f64.powi(p as i32) {
+        // an integer of at most `p` digits prints as itself
+        let mut n = x.abs() as u64;
+        let mut d = [0u8; 20];
+        let mut i = d.len();
+        while n > 0 || i == d.len() {
+            i -= 1;
+            d[i] = b'0' + (n % 10) as u8;
+            n /= 10;
+        }
+        if x < 0.0 {
+            out.push(b'-');
+        }
+        out.extend_from_slice(&d[i..]);
+        return;
+    }
+    // the `p` significant digits and the exponent of `%.{p-1}e`; `%g`'s fixed form
+    // prints the same digits (it rounds at the same place)
+    scratch.clear();
+    let _ = write!(scratch, "{:.*e}", p - 1, x.abs());
+    let (mant, exp) = scratch.split_once('e').unwrap_or((scratch.as_str(), "0"));
+    let exp: i32 = exp.parse().unwrap_or(0);
+    let digits: Vec<u8> = mant.bytes().filter(u8::is_ascii_digit).collect();
+    // significant digits without trailing zeros
+    let n = digits.iter().rposition(|&c| c != b'0').map_or(1, |i| i + 1);
+    let digits = &digits[..n];
+    if x < 0.0 {
+        out.push(b'-');
+    }
+    if exp < -4 || exp >= p as i32 {
+        out.push(digits[0]);
+        if digits.len() > 1 {
+            out.push(b'.');
+            out.extend_from_slice(&digits[1..]);
+        }
+        out.push(b'e');
+        out.push(if exp < 0 { b'-' } else { b'+' });
+        let e = exp.unsigned_abs();
+        if e < 10 {
+            out.push(b'0');
+        }
+        out.extend_from_slice(e.to_string().as_bytes());
+    } else if exp < 0 {
+        out.extend_from_slice(b"0.");
+        out.extend(std::iter::repeat_n(b'0', (-exp - 1) as usize));
+        out.extend_from_slice(digits);
+    } else {
+        let int = exp as usize + 1;
+        if digits.len() <= int {
+            out.extend_from_slice(digits);
+            out.extend(std::iter::repeat_n(b'0', int - digits.len()));
+        } else {
+            out.extend_from_slice(&digits[..int]);
+            out.push(b'.');
+            out.extend_from_slice(&digits[int..]);
+        }
+    }
+}
+
 fn strip_zeros(s: &str) -> &str {
     if s.contains('.') {
         s.trim_end_matches('0').trim_end_matches('.')
@@ -39,7 +107,7 @@ fn strip_zeros(s: &str) -> &str {
 
 #[cfg(test)]
 mod tests {
-    use super::fmt_g;
+    use super::{fmt_g, push_g};
 
     #[test]
     fn matches_printf_g() {
@@ -59,5 +127,65 @@ mod tests {
         assert_eq!(fmt_g(-123456789.0, 9), "-123456789");
         assert_eq!(fmt_g(1234567890.0, 9), "1.23456789e+09");
         assert_eq!(fmt_g(-7.0, 9), "-7");
+    }
+
+    #[test]
+    fn push_g_matches_fmt_g() {
+        let mut vals = vec![
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            0.5,
+            1e-5,
+            1.234e-5,
+            9.999999995e-5,
+            1e-4,
+            0.000123456789,
+            123456789.0,
+            999999999.0,
+            999999999.5,
+            1e9,
+            1.5e9,
+            99.99999999,
+            1e300,
+            -2.5e-300,
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            5e-324,
+            0.1 + 0.2,
+            1.0 / 3.0,
+            2.0 / 3.0,
+            123.456,
+            -0.001,
+            1e21,
+            1e22,
+            4503599627370497.0,
+        ];
+        // a deterministic spread of magnitudes and digits
+        let mut s = 1u64;
+        for _ in 0..20000 {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let m = (s >> 11) as f64 / (1u64 << 53) as f64;
+            let e = ((s >> 3) % 40) as i32 - 20;
+            let v = m * 10f64.powi(e);
+            vals.push(if s & 4 != 0 { -v } else { v });
+            vals.push((v * 1000.0).round());
+        }
+        let mut scratch = String::new();
+        for prec in [1, 2, 6, 9, 15, 17] {
+            for &v in &vals {
+                let mut out = Vec::new();
+                push_g(&mut out, v, prec, &mut scratch);
+                assert_eq!(
+                    String::from_utf8(out).unwrap(),
+                    fmt_g(v, prec),
+                    "{v:e} %.{prec}g"
+                );
+            }
+        }
     }
 }
