@@ -544,3 +544,63 @@ fn oracle_generated_corpus() {
         differ.len() + nan_differ
     );
 }
+
+/// Blocks of records evaluated on several threads give the output of one thread, in
+/// the same order, with the same warnings and the same stop at an error (the input is
+/// about 12 blocks of 256 KB, with warnings, `cond`, blank lines and a line without
+/// its newline at the end).
+#[test]
+fn threads_give_the_output_of_one_thread() {
+    let mut g = Gen(99);
+    let mut input = String::new();
+    for i in 0..150_000 {
+        let n = g.below(5);
+        for k in 0..n {
+            let v = (g.below(20001) as f64 - 10000.0) / 3000.0;
+            input += &format!("{}{v:.*}", if k > 0 { " " } else { "" }, g.below(9));
+        }
+        if i < 149_999 {
+            input.push('\n');
+        }
+    }
+    let progs: [&[&str]; 4] = [
+        &[
+            "-f",
+            "reinhart.cal",
+            "-e",
+            "MF:2;Dx=$1;Dy=$2;Dz=$3;$1=rbin;$2=1/$1;$3=in(0)",
+        ],
+        &["-e", "$1=select($1,1,2);$2=$2;cond=$3+1"],
+        &["-e", "$1=$1*$2+$3;$3=sqrt($2)", "-od"],
+        // stops with an error at the first record whose $1 exceeds 3.3333 (after
+        // about a third of the input)
+        &["-e", "$1=if($1-3.3333, f(1), $1)"],
+    ];
+    for args in progs {
+        let one = run_with(
+            {
+                let mut c = ours(args);
+                c.env("FENESTRA_RCALC_THREADS", "1");
+                c
+            },
+            input.as_bytes(),
+        );
+        let three = run_with(
+            {
+                let mut c = ours(args);
+                c.env("FENESTRA_RCALC_THREADS", "3");
+                c
+            },
+            input.as_bytes(),
+        );
+        assert!(
+            one.1.len() > 100_000,
+            "{args:?}: {} bytes of output",
+            one.1.len()
+        );
+        assert_eq!(one.0, !args[1].contains("f(1)"), "{args:?}: exit status");
+        assert_eq!(one.0, three.0, "{args:?}: exit status");
+        assert!(one.1 == three.1, "{args:?}: outputs differ");
+        assert_eq!(one.2, three.2, "{args:?}: messages differ");
+    }
+}

@@ -675,7 +675,50 @@ fn read_full(r: &mut dyn Read, buf: &mut [u8]) -> Result<usize> {
 
 #[cfg(test)]
 mod tests {
-    use super::atof;
+    use super::{atof, parse_plain};
+
+    #[test]
+    fn plain_decimals_parse_as_str_parse_does() {
+        let mut s = 7u64;
+        let mut n = 0;
+        for _ in 0..200_000 {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let int = (s >> 20) % 10u64.pow(((s >> 8) % 12) as u32);
+            let frac = (s >> 40) % 1_000_000;
+            let w = format!(
+                "{}{int}.{frac:0w$}",
+                ["", "-", "+"][(s % 3) as usize],
+                w = ((s >> 4) % 7) as usize
+            );
+            let want: f64 = w.parse().unwrap();
+            if let Some(v) = parse_plain(w.as_bytes()) {
+                assert_eq!(v.to_bits(), want.to_bits(), "{w}");
+                n += 1;
+            }
+        }
+        assert!(n > 150_000, "{n} plain words");
+        for w in [
+            "",
+            "-",
+            ".",
+            "1e3",
+            "1.5.",
+            "0x1",
+            "nan",
+            "1 ",
+            "99999999999999999999",
+        ] {
+            assert_eq!(parse_plain(w.as_bytes()), None, "{w}");
+        }
+        assert_eq!(
+            parse_plain(b"-0.000").map(f64::to_bits),
+            Some((-0.0f64).to_bits())
+        );
+        assert_eq!(parse_plain(b"5."), Some(5.0));
+        assert_eq!(parse_plain(b".25"), Some(0.25));
+    }
 
     #[test]
     fn atof_reads_prefixes() {
