@@ -126,6 +126,27 @@ pub(crate) enum Op {
         c: u32,
         to: u32,
     },
+    /// Jump to `to` unless `a > b`.
+    JumpNotGt {
+        a: u32,
+        b: u32,
+        to: u32,
+    },
+    /// `d = c > 0 ? x : y`.
+    Pick {
+        d: u32,
+        c: u32,
+        x: u32,
+        y: u32,
+    },
+    /// `d = a > b ? x : y`.
+    PickGt {
+        d: u32,
+        a: u32,
+        b: u32,
+        x: u32,
+        y: u32,
+    },
     Jump {
         to: u32,
     },
@@ -219,8 +240,10 @@ fn dst(op: &mut Op) -> Option<&mut u32> {
         | Op::In { d, .. }
         | Op::Arg { d, .. }
         | Op::Select { d, .. }
-        | Op::SelectK { d, .. } => Some(d),
-        Op::JumpNotPos { .. } | Op::Jump { .. } | Op::Abort => None,
+        | Op::SelectK { d, .. }
+        | Op::Pick { d, .. }
+        | Op::PickGt { d, .. } => Some(d),
+        Op::JumpNotPos { .. } | Op::JumpNotGt { .. } | Op::Jump { .. } | Op::Abort => None,
     }
 }
 
@@ -347,7 +370,9 @@ impl<'a> Fc<'a> {
 
     fn patch(&mut self, at: usize, to: u32) {
         match &mut self.ops[at] {
-            Op::JumpNotPos { to: t, .. } | Op::Jump { to: t } => *t = to,
+            Op::JumpNotPos { to: t, .. } | Op::JumpNotGt { to: t, .. } | Op::Jump { to: t } => {
+                *t = to
+            }
             _ => {}
         }
     }
@@ -782,6 +807,8 @@ pub(crate) fn build(c: &Compiled, root: &Node) -> Option<Fast> {
                 *x = map(*x);
             }
             Op::JumpNotPos { c, .. } => *c = map(*c),
+            // made by the peephole pass, after relocation
+            Op::JumpNotGt { .. } | Op::Pick { .. } | Op::PickGt { .. } => {}
             Op::Select { d, i, .. } | Op::SelectK { d, i, .. } => {
                 *d = map(*d);
                 *i = map(*i);
@@ -800,47 +827,219 @@ pub(crate) fn build(c: &Compiled, root: &Node) -> Option<Fast> {
     }
     let mut regs = fc.consts.clone();
     regs.resize((nk + fc.ntemp) as usize, 0.0);
-    // every register named must exist (`Fast::run` indexes without checks)
-    let n = regs.len() as u32;
-    let ok = |x: u32| x < n;
-    let valid = ok(map(out))
-        && fc.ops.iter().all(|op| {
-            let mut o = *op;
-            let d_ok = dst(&mut o).is_none_or(|d| ok(*d));
-            d_ok && match *op {
-                Op::Copy { a, .. }
-                | Op::Neg { a, .. }
-                | Op::Floor { a, .. }
-                | Op::Math { a, .. }
-                | Op::Rand { a, .. }
-                | Op::In { a, .. }
-                | Op::Arg { a, .. } => ok(a),
-                Op::Add { a, b, .. }
-                | Op::Sub { a, b, .. }
-                | Op::Mul { a, b, .. }
-                | Op::Div { a, b, .. }
-                | Op::Pow { a, b, .. }
-                | Op::Atan2 { y: a, x: b, .. }
-                | Op::Jn { n: a, x: b, .. }
-                | Op::Yn { n: a, x: b, .. } => ok(a) && ok(b),
-                Op::Max { l, n: k, .. } | Op::Min { l, n: k, .. } => {
-                    k > 0 && lists[l as usize..(l + k) as usize].iter().all(|&x| ok(x))
-                }
-                Op::JumpNotPos { c, .. } => ok(c),
-                Op::Select { i, .. } | Op::SelectK { i, .. } => ok(i),
-                _ => true,
-            }
-        });
-    if !valid {
-        return None;
-    }
-    Some(Fast {
+    let nk = fc.consts.len();
+    let mut f = Fast {
         ops: fc.ops,
         lists,
         table: fc.table,
         regs,
         out: map(out),
-    })
+    };
+    peephole(&mut f, nk);
+    // every register named must exist (`Fast::run` indexes without checks)
+    let n = f.regs.len() as u32;
+    let mut valid = f.out < n;
+    for op in &f.ops {
+        let mut o = *op;
+        valid &= dst(&mut o).is_none_or(|d| *d < n);
+        if let Op::Max { l, n: k, .. } | Op::Min { l, n: k, .. } = *op {
+            valid &= k > 0 && ((l + k) as usize) <= f.lists.len();
+        }
+        reads(op, &f.lists, |r| valid &= r < n);
+    }
+    valid.then_some(f)
+}
+
+/// Calls `f` with each register `op` reads.
+fn reads(op: &Op, lists: &[u32], mut f: impl FnMut(u32)) {
+    match *op {
+        Op::Copy { a, .. }
+        | Op::Neg { a, .. }
+        | Op::Floor { a, .. }
+        | Op::Math { a, .. }
+        | Op::Rand { a, .. }
+        | Op::In { a, .. }
+        | Op::Arg { a, .. }
+        | Op::JumpNotPos { c: a, .. }
+        | Op::Select { i: a, .. }
+        | Op::SelectK { i: a, .. } => f(a),
+        Op::Add { a, b, .. }
+        | Op::Sub { a, b, .. }
+        | Op::Mul { a, b, .. }
+        | Op::Div { a, b, .. }
+        | Op::Pow { a, b, .. }
+        | Op::Atan2 { y: a, x: b, .. }
+        | Op::Jn { n: a, x: b, .. }
+        | Op::Yn { n: a, x: b, .. }
+        | Op::JumpNotGt { a, b, .. } => {
+            f(a);
+            f(b);
+        }
+        Op::Pick { c, x, y, .. } => {
+            f(c);
+            f(x);
+            f(y);
+        }
+        Op::PickGt { a, b, x, y, .. } => {
+            f(a);
+            f(b);
+            f(x);
+            f(y);
+        }
+        Op::Max { l, n, .. } | Op::Min { l, n, .. } => {
+            for &r in lists.get(l as usize..(l + n) as usize).unwrap_or(&[]) {
+                f(r);
+            }
+        }
+        Op::Host { .. } | Op::Chan { .. } | Op::Cached { .. } | Op::Jump { .. } | Op::Abort => {}
+    }
+}
+
+/// Calls `f` with each op index `op` may jump to (besides the next op).
+fn targets(op: &Op, lists: &[u32], mut f: impl FnMut(u32)) {
+    match *op {
+        Op::JumpNotPos { to, .. } | Op::JumpNotGt { to, .. } | Op::Jump { to } => f(to),
+        Op::Select { l, n, .. } => {
+            for &t in lists.get(l as usize..=(l + n) as usize).unwrap_or(&[]) {
+                f(t);
+            }
+        }
+        _ => {}
+    }
+}
+
+/// Fuses ops (registers below `nk` are constants). A sign test of a difference, of a
+/// sum with a constant or of a negation becomes a comparison: `a - b > 0` exactly
+/// when `a > b`, `a + k > 0` when `a > -k`, `-a > 0` when `0 > a` (an IEEE sum or
+/// difference is zero only when it is exactly zero, rounding keeps the sign, and
+/// NaNs compare false either way). An `if` choosing between two values already in
+/// registers becomes one op.
+fn peephole(f: &mut Fast, nk: usize) {
+    let n = f.ops.len();
+    let mut uses = vec![0u32; f.regs.len()];
+    let mut landing = vec![0u32; n + 1];
+    for op in &f.ops {
+        reads(op, &f.lists, |r| {
+            if let Some(u) = uses.get_mut(r as usize) {
+                *u += 1
+            }
+        });
+        targets(op, &f.lists, |t| {
+            if let Some(l) = landing.get_mut(t as usize) {
+                *l += 1
+            }
+        });
+    }
+    if let Some(u) = uses.get_mut(f.out as usize) {
+        *u += 1;
+    }
+    // a constant register holding `v` (new ones are added after the temporaries)
+    let base = f.regs.len();
+    let konst = |regs: &mut Vec<f64>, v: f64| -> u32 {
+        let same = |i: &usize| regs[*i].to_bits() == v.to_bits();
+        match (0..nk).chain(base..regs.len()).find(same) {
+            Some(i) => i as u32,
+            None => {
+                regs.push(v);
+                (regs.len() - 1) as u32
+            }
+        }
+    };
+    let mut keep = vec![true; n];
+    // 1. sign tests of differences, sums and negations
+    for i in 0..n.saturating_sub(1) {
+        let Op::JumpNotPos { c, to } = f.ops[i + 1] else {
+            continue;
+        };
+        if landing[i + 1] != 0 || uses.get(c as usize) != Some(&1) {
+            continue;
+        }
+        let fused = match f.ops[i] {
+            Op::Sub { d, a, b } if d == c => Some((a, b)),
+            Op::Add { d, a, b } if d == c && (b as usize) < nk => {
+                let negk = -f.regs[b as usize];
+                let k = konst(&mut f.regs, negk);
+                Some((a, k))
+            }
+            Op::Add { d, a, b } if d == c && (a as usize) < nk => {
+                let negk = -f.regs[a as usize];
+                let k = konst(&mut f.regs, negk);
+                Some((b, k))
+            }
+            Op::Neg { d, a } if d == c => Some((konst(&mut f.regs, 0.0), a)),
+            _ => None,
+        };
+        if let Some((a, b)) = fused {
+            f.ops[i] = Op::JumpNotGt { a, b, to };
+            keep[i + 1] = false;
+        }
+    }
+    // 2. `if` between two registers: test, copy, jump over, copy
+    let next = |i: usize, keep: &[bool]| (i + 1..n).find(|&j| keep[j]);
+    for i in 0..n {
+        if !keep[i] {
+            continue;
+        }
+        let (c, ab, to) = match f.ops[i] {
+            Op::JumpNotPos { c, to } => (Some(c), None, to),
+            Op::JumpNotGt { a, b, to } => (None, Some((a, b)), to),
+            _ => continue,
+        };
+        let Some(j1) = next(i, &keep) else { continue };
+        let Some(j2) = next(j1, &keep) else { continue };
+        let Some(j3) = next(j2, &keep) else { continue };
+        let (Op::Copy { d, a: x }, Op::Jump { to: end }, Op::Copy { d: d2, a: y }) =
+            (f.ops[j1], f.ops[j2], f.ops[j3])
+        else {
+            continue;
+        };
+        let after = next(j3, &keep).unwrap_or(n);
+        if d != d2
+            || to as usize != j3
+            || end as usize != after
+            || landing[j1] != 0
+            || landing[j2] != 0
+            || landing[j3] != 1
+        {
+            continue;
+        }
+        f.ops[i] = match (c, ab) {
+            (Some(c), _) => Op::Pick { d, c, x, y },
+            (_, Some((a, b))) => Op::PickGt { d, a, b, x, y },
+            _ => continue,
+        };
+        keep[j1] = false;
+        keep[j2] = false;
+        keep[j3] = false;
+        landing[after] -= 1;
+    }
+    // 3. the ops kept, jump targets renumbered
+    let mut newidx = vec![0u32; n + 1];
+    let mut k = 0u32;
+    for (i, x) in newidx.iter_mut().enumerate() {
+        *x = k;
+        if i < n && keep[i] {
+            k += 1;
+        }
+    }
+    let old = std::mem::take(&mut f.ops);
+    for (i, mut op) in old.into_iter().enumerate() {
+        if !keep[i] {
+            continue;
+        }
+        match &mut op {
+            Op::JumpNotPos { to, .. } | Op::JumpNotGt { to, .. } | Op::Jump { to } => {
+                *to = newidx[*to as usize]
+            }
+            Op::Select { l, n, .. } => {
+                for t in &mut f.lists[*l as usize..=(*l + *n) as usize] {
+                    *t = newidx[*t as usize];
+                }
+            }
+            _ => {}
+        }
+        f.ops.push(op);
+    }
 }
 
 /// What the fast code reads besides its registers.
@@ -970,6 +1169,28 @@ impl Fast {
                     }
                 }
                 Op::Jump { to } => pc = to as usize,
+                Op::JumpNotGt { a, b, to } => {
+                    if r[a as usize] <= r[b as usize]
+                        || r[a as usize].is_nan()
+                        || r[b as usize].is_nan()
+                    {
+                        pc = to as usize;
+                    }
+                }
+                Op::Pick { d, c, x, y } => {
+                    r[d as usize] = if r[c as usize] > 0.0 {
+                        r[x as usize]
+                    } else {
+                        r[y as usize]
+                    };
+                }
+                Op::PickGt { d, a, b, x, y } => {
+                    r[d as usize] = if r[a as usize] > r[b as usize] {
+                        r[x as usize]
+                    } else {
+                        r[y as usize]
+                    };
+                }
                 Op::Select { d, i, l, n } => {
                     let x = r[i as usize];
                     if x.is_nan() || x < -0.5 || x + 0.5 >= 2147483648.0 {
@@ -1077,18 +1298,61 @@ mod tests {
         v
     }
 
+    /// The fused comparisons and picks on NaNs, infinities, signed zeros and
+    /// subnormals: the values of the exact evaluator.
+    #[test]
+    fn fused_tests_agree_on_special_values() {
+        let src = "$1 = if($1 - $2, 1, 2); $2 = if($1 + 3, 5, $2); $3 = if(-$1, $3, 7);\n\
+                   $4 = if($1 - $2, $1 - 1, $2 + 1); $5 = if(3 + $2, $1, $2);\n\
+                   $6 = if($1 - 5e-324, -0, 0) + if($1 + -5e-324, 1, 0)*10;";
+        let mut p = Program::for_rcalc();
+        p.load_str("-e", src).unwrap();
+        let fast = p.compile().unwrap();
+        let mut exact = fast.clone();
+        exact.fast.clear();
+        let special = [
+            f64::NAN,
+            -f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            0.0,
+            -0.0,
+            1.0,
+            -3.0,
+            5e-324,
+            -5e-324,
+            1e308,
+            -1e308,
+        ];
+        let (mut sf, mut se) = (fast.state(), exact.state());
+        for &a in &special {
+            for &b in &special {
+                let r = [a, b, 0.25];
+                assert_eq!(
+                    outcome(&fast, &mut sf, &r),
+                    outcome(&exact, &mut se, &r),
+                    "{r:?}"
+                );
+            }
+        }
+        assert_eq!(sf.fast_hits, (special.len() * special.len() * 6) as u64);
+    }
+
     /// Random programs evaluated with and without fast code: the same values, errors
     /// and warnings on every record.
     #[test]
     fn fast_code_agrees_with_the_exact_evaluator() {
         let mut g = Gen(12345, 3);
-        let recs: [&[f64]; 6] = [
+        let recs: [&[f64]; 8] = [
             &[0.5, 2.0, -3.0],
             &[0.0, 1e-3, 7.25],
             &[-1.5, 0.0, 100.0],
             &[3.0, -0.25, 0.125],
             &[1.0, 1.0],
             &[0.0, 0.0, 0.0],
+            // infinities and subnormals
+            &[1e300, -1e308, 5e-324],
+            &[-0.0, 1.7e308, -1e-310],
         ];
         let (mut hits, mut evals) = (0, 0);
         for _ in 0..2000 {
