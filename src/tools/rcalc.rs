@@ -206,48 +206,73 @@ const POW10: [f64; 23] = [
     1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
 ];
 
-/// A plain decimal word (`[+-]digits[.digits]`) whose digits fit in 53 bits: its
-/// value as one correctly rounded division of two exact numbers (the same value as
-/// `str::parse`); `None` for anything else.
-#[inline]
-fn parse_plain(w: &[u8]) -> Option<f64> {
-    let (neg, mut i) = match w.first() {
-        Some(b'-') => (true, 1),
-        Some(b'+') => (false, 1),
-        _ => (false, 0),
-    };
-    let (mut m, mut nd, mut frac) = (0u64, 0u32, 0usize);
-    while let Some(&c) = w.get(i) {
-        if !c.is_ascii_digit() {
-            break;
-        }
-        m = m * 10 + u64::from(c - b'0');
-        nd += 1;
-        if nd > 18 {
-            return None;
-        }
+/// A plain decimal number (`[+-]digits[.digits]`, at most 18 digits, at most 2^53)
+/// at `buf[i..]` ending at white space or at the end of `buf`: its value as one
+/// correctly rounded division of two exact numbers (the value `str::parse` gives),
+/// and where it ends; `None` for anything else.
+#[inline(always)]
+fn plain_at(buf: &[u8], mut i: usize) -> Option<(f64, usize)> {
+    let n = buf.len();
+    let neg = i < n && buf[i] == b'-';
+    if i < n && (neg || buf[i] == b'+') {
         i += 1;
     }
-    if w.get(i) == Some(&b'.') {
+    let (mut m, mut nd, mut frac) = (0u64, 0u32, 0usize);
+    while i < n && buf[i].is_ascii_digit() && nd < 19 {
+        m = m * 10 + u64::from(buf[i] - b'0');
+        nd += 1;
         i += 1;
-        while let Some(&c) = w.get(i) {
-            if !c.is_ascii_digit() {
-                break;
-            }
-            m = m * 10 + u64::from(c - b'0');
+    }
+    if i < n && buf[i] == b'.' {
+        i += 1;
+        while i < n && buf[i].is_ascii_digit() && nd < 19 {
+            m = m * 10 + u64::from(buf[i] - b'0');
             nd += 1;
             frac += 1;
-            if nd > 18 {
-                return None;
-            }
             i += 1;
         }
     }
-    if nd == 0 || i != w.len() || m > 1 << 53 || frac >= POW10.len() {
+    if nd == 0 || nd > 18 || (i < n && !is_ws(buf[i])) || m > 1 << 53 || frac >= POW10.len() {
         return None;
     }
     let v = m as f64 / POW10[frac];
-    Some(if neg { -v } else { v })
+    Some((if neg { -v } else { v }, i))
+}
+
+/// A plain decimal word (see [`plain_at`]).
+fn parse_plain(w: &[u8]) -> Option<f64> {
+    plain_at(w, 0)
+        .filter(|&(_, e)| e == w.len())
+        .map(|(v, _)| v)
+}
+
+/// The columns of the line at the start of `buf`, split at white space; returns the
+/// length of the line with its newline.
+fn ws_line(buf: &[u8], cols: &mut Vec<f64>) -> Result<usize> {
+    cols.clear();
+    let n = buf.len();
+    let mut i = 0;
+    loop {
+        while i < n && matches!(buf[i], b' ' | b'\t' | b'\r' | b'\x0C') {
+            i += 1;
+        }
+        if i >= n {
+            return Ok(n);
+        }
+        if buf[i] == b'\n' {
+            return Ok(i + 1);
+        }
+        if let Some((v, e)) = plain_at(buf, i) {
+            cols.push(v);
+            i = e;
+            continue;
+        }
+        let s = i;
+        while i < n && !is_ws(buf[i]) {
+            i += 1;
+        }
+        cols.push(word_value(&buf[s..i])?);
+    }
 }
 
 /// A word's value as C's `atof` reads it (see [`atof`]).
@@ -270,19 +295,8 @@ fn line_cols(line: &[u8], sep: Option<char>, count: usize, cols: &mut Vec<f64>) 
     cols.clear();
     match sep {
         None => {
-            let mut i = 0;
-            while i < line.len() {
-                while i < line.len() && is_ws(line[i]) {
-                    i += 1;
-                }
-                let s = i;
-                while i < line.len() && !is_ws(line[i]) {
-                    i += 1;
-                }
-                if i > s {
-                    cols.push(word_value(&line[s..i])?);
-                }
-            }
+            // (a carriage return is white space)
+            ws_line(line, cols)?;
         }
         Some(c) => {
             let text = std::str::from_utf8(line)
@@ -311,10 +325,30 @@ fn eval_block(ev: &mut Eval, framing: Framing, fname: &str, block: &[u8], last: 
     let err = (|| -> Result<()> {
         match framing {
             Framing::Ascii { sep, count } => {
-                for line in block.split_inclusive(|&b| b == b'\n') {
-                    let line = line.strip_suffix(b"\n").unwrap_or(line);
-                    line_cols(line, sep, count, &mut cols)
-                        .with_context(|| format!("reading {fname}"))?;
+                let mut at = 0;
+                while at < block.len() {
+                    let len = match sep {
+                        None => {
+                            let len = ws_line(&block[at..], &mut cols)
+                                .with_context(|| format!("reading {fname}"))?;
+                            if count > 0 {
+                                cols.truncate(count);
+                            }
+                            len
+                        }
+                        Some(_) => {
+                            let rest = &block[at..];
+                            let len = rest
+                                .iter()
+                                .position(|&b| b == b'\n')
+                                .map_or(rest.len(), |i| i + 1);
+                            let line = rest[..len].strip_suffix(b"\n").unwrap_or(&rest[..len]);
+                            line_cols(line, sep, count, &mut cols)
+                                .with_context(|| format!("reading {fname}"))?;
+                            len
+                        }
+                    };
+                    at += len;
                     ev.st.set_chans(&cols);
                     ev.record(&mut out)?;
                 }

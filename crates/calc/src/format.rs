@@ -60,10 +60,18 @@ pub fn push_g(out: &mut Vec<u8>, x: f64, prec: usize, scratch: &mut String) {
     let _ = write!(scratch, "{:.*e}", p - 1, x.abs());
     let (mant, exp) = scratch.split_once('e').unwrap_or((scratch.as_str(), "0"));
     let exp: i32 = exp.parse().unwrap_or(0);
-    let digits: Vec<u8> = mant.bytes().filter(u8::is_ascii_digit).collect();
+    let mut buf = [0u8; 24];
+    let mut nd = 0;
+    for c in mant.bytes().filter(u8::is_ascii_digit).take(buf.len()) {
+        buf[nd] = c;
+        nd += 1;
+    }
     // significant digits without trailing zeros
-    let n = digits.iter().rposition(|&c| c != b'0').map_or(1, |i| i + 1);
-    let digits = &digits[..n];
+    let n = buf[..nd]
+        .iter()
+        .rposition(|&c| c != b'0')
+        .map_or(1, |i| i + 1);
+    let digits = &buf[..n];
     if x < 0.0 {
         out.push(b'-');
     }
@@ -76,10 +84,11 @@ pub fn push_g(out: &mut Vec<u8>, x: f64, prec: usize, scratch: &mut String) {
         out.push(b'e');
         out.push(if exp < 0 { b'-' } else { b'+' });
         let e = exp.unsigned_abs();
-        if e < 10 {
-            out.push(b'0');
+        if e >= 100 {
+            out.push(b'0' + (e / 100) as u8);
         }
-        out.extend_from_slice(e.to_string().as_bytes());
+        out.push(b'0' + (e / 10 % 10) as u8);
+        out.push(b'0' + (e % 10) as u8);
     } else if exp < 0 {
         out.extend_from_slice(b"0.");
         out.extend(std::iter::repeat_n(b'0', (-exp - 1) as usize));
