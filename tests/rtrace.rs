@@ -266,7 +266,7 @@ fn run_scene(text: &str, input: &str, extra: &[&str]) -> std::process::Output {
 #[test]
 fn bad_input_gives_one_clear_error_and_no_output() {
     let cases = [
-        ("void antimatter am 1 glass 0 0\nam sphere s 0 0 4 0 0 0 1\n", "antimatter"),
+        ("void plastic p 0 0 5 .5 .5 .5 0 0\np mesh m 1 x.rtm 0 0\n", "mesh"),
         ("void plastic p 0 0 5 .5 .5 .5 0 0\np instance i 1 x.oct 0 0\n", "instance"),
         ("void brightfunc b 2 f my.cal 0 0\nb plastic p 0 0 5 .5 .5 .5 0 0\np sphere s 0 0 4 0 0 0 1\n", "brightfunc"),
     ];

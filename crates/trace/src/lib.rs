@@ -13,6 +13,7 @@
 
 pub mod bsdf_mat;
 pub mod bvh;
+pub mod clip;
 pub mod datafile;
 pub mod material;
 pub mod options;

@@ -46,6 +46,14 @@ pub enum Material {
     },
     /// Klems BSDF from an XML file.
     Bsdf(Box<crate::bsdf_mat::BsdfMat>),
+    /// `antimatter`: the modifiers rays inside it do not see, and the material (the first
+    /// modifier, unless `void`) that shades where a ray leaves it inside such a volume.
+    Antimatter {
+        /// Scene indices of the named modifiers (unknown names are skipped with a warning).
+        mods: Vec<usize>,
+        /// Scene index of the first modifier, if not `void` and defined.
+        first: Option<usize>,
+    },
     /// light, glow, illum, spotlight.
     Light {
         /// Radiance.
@@ -199,6 +207,25 @@ pub fn compile(scene: &Scene, i: usize) -> Result<Material> {
                 color: rgb(p),
                 kind: LightKind::Spot(half.cos(), aim),
             }
+        }
+        "antimatter" => {
+            let mut mods = Vec::new();
+            let mut first = None;
+            for (k, name) in p.sargs.iter().enumerate() {
+                if name == "void" {
+                    continue;
+                }
+                // Unknown names: Radiance warns and goes on; the caller reports it.
+                if let Some(m) = scene.find_modifier(name, i) {
+                    if !mods.contains(&m) {
+                        mods.push(m);
+                    }
+                    if k == 0 {
+                        first = Some(m);
+                    }
+                }
+            }
+            Material::Antimatter { mods, first }
         }
         other => bail!(
             "{}: material type '{other}' of '{}' is not supported by fenestra's ray tracer",

@@ -12,6 +12,7 @@ use fenestra_scene::Scene;
 use glam::DVec3;
 
 use crate::bvh::Accel;
+use crate::clip::ClipSet;
 use crate::material::{compile, is_pattern, LightKind, Material, FTINY};
 use crate::options::TraceOptions;
 use crate::pattern::PatternInput;
@@ -63,6 +64,8 @@ struct Ray {
     skip: Option<usize>,
     /// Distance travelled before this ray's origin.
     start: f64,
+    /// Modifiers this ray does not see (inside antimatter).
+    clip: ClipSet,
 }
 
 /// A map from scene index to value stored densely (indexing is a bounds check, not a hash).
@@ -348,6 +351,38 @@ impl Tracer {
             surf_prim.push(i);
             surf_mat.push(m);
         }
+        // Antimatter: the material of its first modifier shades where rays leave it.
+        let firsts: Vec<(usize, usize)> = surf_mat
+            .iter()
+            .filter_map(|&m| match &mats[&m] {
+                Material::Antimatter { first: Some(f), .. } => Some((m, *f)),
+                _ => None,
+            })
+            .collect();
+        for (am, f) in firsts {
+            need_mat(f, &mut mats)?;
+            if matches!(mats[&f], Material::Antimatter { .. }) {
+                let p = &scene.prims[am];
+                bail!(
+                    "{}: antimatter '{}': its first modifier '{}' is itself antimatter",
+                    p.loc,
+                    p.name,
+                    scene.prims[f].name
+                );
+            }
+        }
+        for (i, p) in scene.prims.iter().enumerate() {
+            if p.ptype == "antimatter" && mats.contains_key(&i) {
+                for name in p.sargs.iter().filter(|n| *n != "void") {
+                    if scene.find_modifier(name, i).is_none() {
+                        warnings.push(format!(
+                            "{}: antimatter '{}': unknown modifier '{name}' ignored",
+                            p.loc, p.name
+                        ));
+                    }
+                }
+            }
+        }
         // light sources
         let mut sources = Vec::new();
         for (s, &m) in surf_mat.iter().enumerate() {
@@ -414,7 +449,7 @@ impl Tracer {
             Material::Normal {
                 spec, trans, tspec, ..
             } => *spec > FTINY || (*trans > FTINY && *tspec > FTINY),
-            Material::Light { .. } => false,
+            Material::Light { .. } | Material::Antimatter { .. } => false,
         });
         let mut notes = Vec::new();
         let direct = !sources.is_empty() || opts.full;
@@ -449,11 +484,13 @@ impl Tracer {
                 kind: LightKind::Illum(_),
                 ..
             } => true,
+            // clipped surfaces let shadow rays through
+            Material::Antimatter { .. } => true,
             _ => false,
         });
         let occlusion_shadows = !passes_shadows && !opts.full;
         notes.push(if passes_shadows {
-            "shadow rays: traced through surfaces (glass, illum or transmitting materials present)"
+            "shadow rays: traced through surfaces (glass, illum, antimatter or transmitting materials present)"
                 .into()
         } else {
             "shadow rays to distant sources: occlusion test only (no material lets them through)"
@@ -510,6 +547,7 @@ impl Tracer {
             src: None,
             skip: None,
             start: 0.0,
+            clip: ClipSet::default(),
         }
     }
 
@@ -678,6 +716,7 @@ impl Tracer {
             src: if flag == TRANS { r.src } else { None },
             skip,
             start: r.start + dist,
+            clip: r.clip,
         }
     }
 
@@ -766,6 +805,12 @@ impl Tracer {
                 let p = r.org + r.dir * h.t;
                 let n = self.accel.shapes[h.shape].normal(p);
                 let m = self.surf_mat[h.shape];
+                if !r.clip.is_empty() && r.clip.contains(m) {
+                    // inside antimatter: this surface is not there
+                    let mut c = r.clone();
+                    c.clip.cross(m, r.dir.dot(n) < 0.0);
+                    return self.pass(&c, h.shape, p, h.t, cx);
+                }
                 let (val, zeroed) = self.shade(r, m, h.shape, p, n, h.t, cx);
                 self.report(cx, r, self.surf_prim[h.shape], val, p, n, h.t, zeroed);
                 val
@@ -817,6 +862,10 @@ impl Tracer {
                 false,
             ),
             Material::Bsdf(b) => (self.shade_bsdf(r, b, shape, p, n, t, cx), false),
+            // Not reported to rcontrib: the surface itself is invisible.
+            Material::Antimatter { mods, first } => {
+                (self.antimatter(r, mods, *first, shape, p, n, t, cx), true)
+            }
             Material::Mirror { color } => {
                 if r.flags & SHADOW != 0 {
                     return (self.relay(r, shape, p, n, rod, t, *color, cx), false);
@@ -863,6 +912,40 @@ impl Tracer {
                 false,
             ),
         }
+    }
+
+    /// A ray reaching an antimatter surface: entering, it goes on blind to `mods`; leaving
+    /// inside a volume of `first`, the surface is shaded with `first` facing the ray (the
+    /// ray's clip set kept for what that spawns); otherwise it goes on seeing `mods` again.
+    #[allow(clippy::too_many_arguments)]
+    fn antimatter(
+        &self,
+        r: &Ray,
+        mods: &[usize],
+        first: Option<usize>,
+        shape: usize,
+        p: DVec3,
+        n: DVec3,
+        t: f64,
+        cx: &mut Ctx,
+    ) -> DVec3 {
+        let mut c = r.clone();
+        if r.dir.dot(n) < 0.0 {
+            for &m in mods {
+                // a ninth simultaneous modifier is not clipped (MAX_CLIP)
+                c.clip.insert(m);
+            }
+        } else {
+            if let Some(f) = first {
+                if r.clip.inside(f) {
+                    return self.shade(r, f, shape, p, -n, t, cx).0;
+                }
+            }
+            for &m in mods {
+                c.clip.remove(m);
+            }
+        }
+        self.pass(&c, shape, p, t, cx)
     }
 
     #[allow(clippy::too_many_arguments)]
