@@ -99,7 +99,7 @@ impl Program {
         }
         // FENESTRA_CALC_EXACT=1 leaves out the fast code (for comparisons and timing)
         if std::env::var_os("FENESTRA_CALC_EXACT").is_none_or(|v| v.is_empty() || v == "0") {
-            out.build_fast();
+            out.enable_fast();
         }
         Ok(out)
     }

@@ -4,6 +4,7 @@
 #![allow(clippy::borrow_interior_mutable_const)]
 
 use std::cell::Cell;
+use std::sync::OnceLock;
 
 use crate::builtins::{self, Builtin};
 use crate::error::{CalcError, ErrorKind};
@@ -53,7 +54,8 @@ pub struct Compiled {
     pub(crate) errors: Vec<CalcError>,
     /// Fast code per root (see `crate::fast`): variables, then channels (in the order
     /// of `chans`), then standalone expressions; `None` where a root has none.
-    pub(crate) fast: Vec<Option<Fast>>,
+    /// Each is built at the root's first evaluation.
+    pub(crate) fast: Vec<OnceLock<Option<Fast>>>,
 }
 
 /// Warnings Radiance prints while evaluating (counted; the host reports them).
@@ -254,11 +256,7 @@ impl Compiled {
             warnings: Warnings::default(),
             errno: ErrFlag::None,
             errno_writes: 0,
-            fast_regs: self
-                .fast
-                .iter()
-                .map(|f| f.as_ref().map(|f| f.regs.clone()).unwrap_or_default())
-                .collect(),
+            fast_regs: vec![Vec::new(); self.fast.len()],
             fast_epoch: 0,
             fast_roots: Vec::new(),
             exact_epoch: 0,
@@ -308,31 +306,43 @@ impl Compiled {
         self.vars.iter().any(|s| matches!(s, VarSlot::Def(_, true)))
     }
 
-    /// Builds the fast code of every root (after folding).
-    pub(crate) fn build_fast(&mut self) {
-        let mut fast = Vec::new();
-        for v in &self.vars {
-            fast.push(match v {
+    /// Makes room for the fast code of every root (built at first use).
+    pub(crate) fn enable_fast(&mut self) {
+        let n = self.vars.len() + self.chans.len() + self.exprs.len();
+        self.fast = (0..n).map(|_| OnceLock::new()).collect();
+    }
+
+    /// Builds the fast code of root `id`.
+    fn build_fast(&self, id: usize) -> Option<Fast> {
+        let (nv, nc) = (self.vars.len(), self.chans.len());
+        let node = if id < nv {
+            match &self.vars[id] {
                 // a `:` variable keeps its first value: always exact (it is cached)
-                VarSlot::Def(n, false) => crate::fast::build(self, n),
-                _ => None,
-            });
-        }
-        for (_, n) in &self.chans {
-            fast.push(crate::fast::build(self, n));
-        }
-        for n in &self.exprs {
-            fast.push(crate::fast::build(self, n));
-        }
-        self.fast = fast;
+                VarSlot::Def(n, false) => n,
+                _ => return None,
+            }
+        } else if id < nv + nc {
+            &self.chans[id - nv].1
+        } else {
+            &self.exprs[id - nv - nc]
+        };
+        crate::fast::build(self, node)
     }
 
     /// Tries the fast code of root `id`; `None` when there is none or it gave up.
     #[inline]
     fn try_fast(&self, st: &mut State, id: usize) -> Option<f64> {
-        let f = self.fast.get(id)?.as_ref()?;
         if st.exact_epoch == st.epoch {
             return None;
+        }
+        let f = self
+            .fast
+            .get(id)?
+            .get_or_init(|| self.build_fast(id))
+            .as_ref()?;
+        let regs = st.fast_regs.get_mut(id)?;
+        if regs.len() != f.regs.len() {
+            regs.clone_from(&f.regs);
         }
         let inp = Inputs {
             vals: &st.vals,
