@@ -83,6 +83,18 @@ pub(crate) enum Op {
         d: u32,
         a: u32,
     },
+    Asin {
+        d: u32,
+        a: u32,
+    },
+    Acos {
+        d: u32,
+        a: u32,
+    },
+    Sqrt {
+        d: u32,
+        a: u32,
+    },
     Math {
         d: u32,
         a: u32,
@@ -209,6 +221,9 @@ fn key(op: &Op) -> Option<Key> {
         Op::Pow { a, b, .. } => (7, a, b, 0),
         Op::Atan2 { y, x, .. } => (8, y, x, 0),
         Op::Floor { a, .. } => (9, a, 0, 0),
+        Op::Asin { a, .. } => (14, a, 0, 0),
+        Op::Acos { a, .. } => (15, a, 0, 0),
+        Op::Sqrt { a, .. } => (16, a, 0, 0),
         Op::Math { a, m, .. } => (10, a, m as u32, 0),
         Op::Rand { a, .. } => (11, a, 0, 0),
         Op::In { a, .. } => (12, a, 0, 0),
@@ -231,6 +246,9 @@ fn dst(op: &mut Op) -> Option<&mut u32> {
         | Op::Pow { d, .. }
         | Op::Atan2 { d, .. }
         | Op::Floor { d, .. }
+        | Op::Asin { d, .. }
+        | Op::Acos { d, .. }
+        | Op::Sqrt { d, .. }
         | Op::Math { d, .. }
         | Op::Max { d, .. }
         | Op::Min { d, .. }
@@ -576,10 +594,12 @@ impl<'a> Fc<'a> {
 
     fn math1(&mut self, m: Math1, a: &'a Node, fr: usize) -> Result<u32, GiveUp> {
         let a = self.node(a, fr)?;
-        if m == Math1::Floor {
-            self.unary(a, |x| m.apply(x), |d, a| Op::Floor { d, a })
-        } else {
-            self.unary(a, |x| m.apply(x), |d, a| Op::Math { d, a, m })
+        match m {
+            Math1::Floor => self.unary(a, |x| m.apply(x), |d, a| Op::Floor { d, a }),
+            Math1::Asin => self.unary(a, |x| m.apply(x), |d, a| Op::Asin { d, a }),
+            Math1::Acos => self.unary(a, |x| m.apply(x), |d, a| Op::Acos { d, a }),
+            Math1::Sqrt => self.unary(a, |x| m.apply(x), |d, a| Op::Sqrt { d, a }),
+            _ => self.unary(a, |x| m.apply(x), |d, a| Op::Math { d, a, m }),
         }
     }
 
@@ -780,6 +800,9 @@ pub(crate) fn build(c: &Compiled, root: &Node) -> Option<Fast> {
             Op::Copy { d, a }
             | Op::Neg { d, a }
             | Op::Floor { d, a }
+            | Op::Asin { d, a }
+            | Op::Acos { d, a }
+            | Op::Sqrt { d, a }
             | Op::Math { d, a, .. }
             | Op::Rand { d, a }
             | Op::In { d, a }
@@ -856,6 +879,9 @@ fn reads(op: &Op, lists: &[u32], mut f: impl FnMut(u32)) {
         Op::Copy { a, .. }
         | Op::Neg { a, .. }
         | Op::Floor { a, .. }
+        | Op::Asin { a, .. }
+        | Op::Acos { a, .. }
+        | Op::Sqrt { a, .. }
         | Op::Math { a, .. }
         | Op::Rand { a, .. }
         | Op::In { a, .. }
@@ -1040,6 +1066,25 @@ fn peephole(f: &mut Fast, nk: usize) {
         }
         f.ops.push(op);
     }
+    // 4. a jump to a jump goes straight to the latter's target
+    let ops = f.ops.clone();
+    let hop = |mut t: u32| {
+        for _ in 0..8 {
+            match ops.get(t as usize) {
+                Some(Op::Jump { to }) => t = *to,
+                _ => break,
+            }
+        }
+        t
+    };
+    for op in &mut f.ops {
+        match op {
+            Op::JumpNotPos { to, .. } | Op::JumpNotGt { to, .. } | Op::Jump { to } => {
+                *to = hop(*to)
+            }
+            _ => {}
+        }
+    }
 }
 
 /// What the fast code reads besides its registers.
@@ -1127,6 +1172,9 @@ impl Fast {
                 Op::Pow { d, a, b } => r[d as usize] = r[a as usize].powf(r[b as usize]),
                 Op::Atan2 { d, y, x } => r[d as usize] = r[y as usize].atan2(r[x as usize]),
                 Op::Floor { d, a } => r[d as usize] = floor0(r[a as usize]),
+                Op::Asin { d, a } => r[d as usize] = Math1::Asin.apply(r[a as usize]),
+                Op::Acos { d, a } => r[d as usize] = Math1::Acos.apply(r[a as usize]),
+                Op::Sqrt { d, a } => r[d as usize] = Math1::Sqrt.apply(r[a as usize]),
                 Op::Math { d, a, m } => r[d as usize] = m.apply(r[a as usize]),
                 Op::Max { d, l, n } | Op::Min { d, l, n } => {
                     let is_max = matches!(op, Op::Max { .. });
