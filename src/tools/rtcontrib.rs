@@ -412,37 +412,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             .collect()
     });
 
-    // -ld+ (not with -I, which ignores the length as Radiance does): which surfaces end
-    // a ray, i.e. whose material has no straight continuation (glass, trans, illum,
-    // BSDF... would carry the remaining length on, which fenestra does not support)
-    let stops = (limit_dist && !irr).then(|| {
-        scene
-            .prims
-            .iter()
-            .map(|p| {
-                let t = p
-                    .modifier
-                    .map(|m| scene.prims[m].ptype.as_str())
-                    .unwrap_or("");
-                matches!(
-                    t,
-                    "plastic"
-                        | "metal"
-                        | "plastic2"
-                        | "metal2"
-                        | "plasfunc"
-                        | "metfunc"
-                        | "plasdata"
-                        | "metdata"
-                        | "mirror"
-                        | "glow"
-                        | "light"
-                        | "spotlight"
-                        | "ashik2"
-                )
-            })
-            .collect()
-    });
+    // -ld+ (not with -I, which ignores the length as Radiance does)
+    let stops = limit_dist && !irr;
 
     // Input.
     let expect = if yres > 0 {
@@ -460,7 +431,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     if dynamic {
         let probe_opts = RunOptions {
             irradiance_at_hit: hit_kinds.clone(),
-            limit_dist: stops.clone(),
+            limit_dist: stops,
             irradiance: irr,
             value,
             // the same random streams as the main pass: replicas with -E -c 1, ray

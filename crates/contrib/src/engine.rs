@@ -136,9 +136,9 @@ pub struct RunOptions {
     pub errors: bool,
     /// With `-c 1` and errors: independent batches per ray (the value is their mean).
     pub batches: usize,
-    /// `-ld+`: rays end at the length of their direction vector; per scene primitive,
-    /// whether a ray hitting it stops there (no straight continuation).
-    pub limit_dist: Option<Vec<bool>>,
+    /// `-ld+`: rays end at the length of their direction vector (transmitted rays carry
+    /// the rest on).
+    pub limit_dist: bool,
 }
 
 /// One output record: values and (when asked) standard errors, `3 × total bins` each.
@@ -296,7 +296,7 @@ impl<'a> Engine<'a> {
             let d = ray.dir.normalize();
             let mut o = ray.org;
             // -ld+: what is left of the ray's length (passing surfaces does not reset it)
-            let mut left = if self.opts.limit_dist.is_some() {
+            let mut left = if self.opts.limit_dist {
                 ray.dir.length()
             } else {
                 f64::INFINITY
@@ -337,24 +337,17 @@ impl<'a> Engine<'a> {
             self.tracer
                 .contributions_irradiance(index, ray.org, ray.dir, &self.tracked, &mut sink);
         } else {
-            if let Some(stops) = &self.opts.limit_dist {
-                // -ld+: the ray ends at the length of its direction vector. Without a
-                // surface before that point nothing is seen (not even a distant
-                // source); a surface the ray would continue through is not supported.
-                let len = ray.dir.length();
-                let h = self.tracer.first_hit(ray.org, ray.dir);
-                match h.prim {
-                    Some(p) if h.t < len => {
-                        if !stops.get(p).copied().unwrap_or(false) {
-                            self.set_fail(format!(
-                                "-ld+: the ray from {} {} {} (length {len}) reaches a surface it would continue through (transmitting or pass-through material) at distance {}; limiting the continued ray is not supported by fenestra's rtcontrib",
-                                ray.org.x, ray.org.y, ray.org.z, h.t
-                            ));
-                            return;
-                        }
-                    }
-                    _ => return,
-                }
+            if self.opts.limit_dist {
+                // -ld+: the ray ends at the length of its direction vector
+                self.tracer.contributions_limited(
+                    index,
+                    ray.org,
+                    ray.dir,
+                    ray.dir.length(),
+                    &self.tracked,
+                    &mut sink,
+                );
+                return;
             }
             self.tracer
                 .contributions(index, ray.org, ray.dir, &self.tracked, &mut sink);

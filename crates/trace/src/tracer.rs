@@ -610,6 +610,37 @@ impl Tracer {
         v.to_array()
     }
 
+    /// As [`contributions`](Self::contributions) for a ray that ends after `len` (rcontrib
+    /// `-ld+`): nothing beyond, not even a distant source; rays transmitted on the way keep
+    /// what is left of the length.
+    pub fn contributions_limited(
+        &self,
+        ray_index: u64,
+        org: DVec3,
+        dir: DVec3,
+        len: f64,
+        tracked: &[bool],
+        sink: &mut impl FnMut(Contribution),
+    ) -> [f64; 3] {
+        let d = dir.normalize_or_zero();
+        if d == DVec3::ZERO || len.is_nan() || len <= 0.0 {
+            return [0.0; 3];
+        }
+        let mut cx = Ctx {
+            rng: Rng::for_ray(self.opts.seed, ray_index),
+            rays: 0,
+            tracked,
+            sink: Some(sink),
+        };
+        let r = Ray {
+            tmax: len,
+            ..Self::primary(org, d)
+        };
+        let v = self.trace(&r, &mut cx);
+        self.count(&cx);
+        v.to_array()
+    }
+
     /// As [`contributions`](Self::contributions) for an irradiance request (`-I+`):
     /// `point` and `normal` as in [`irradiance`](Self::irradiance).
     pub fn contributions_irradiance(
@@ -704,10 +735,18 @@ impl Tracer {
         skip: Option<usize>,
         dist: f64,
     ) -> Ray {
+        // A transmitted ray carries on what is left of a limited length (rcontrib -ld+:
+        // Radiance limits the ray through glass, not the reflected one); shadow rays set
+        // their own length.
+        let tmax = if flag == TRANS && r.flags & SHADOW == 0 && r.tmax.is_finite() {
+            r.tmax - dist
+        } else {
+            f64::INFINITY
+        };
         Ray {
             org,
             dir,
-            tmax: f64::INFINITY,
+            tmax,
             flags: r.flags | flag,
             weight: r.weight * maxc(rcoef),
             coef: r.coef * rcoef,
