@@ -4,7 +4,6 @@
 mod common;
 
 use std::fmt::Write as _;
-use std::path::Path;
 
 /// An axis-aligned box of six outward-facing polygons (as genbox writes them), corner `lo`,
 /// size `d`.
@@ -45,23 +44,6 @@ fn walls(wall_mat: &str) -> String {
     s
 }
 
-fn both(o: &common::Oracle, dir: &Path, opts: &[&str], rays: &str) -> (Vec<f64>, Vec<f64>) {
-    let mut c = o.command("oconv");
-    c.arg("scene.rad").current_dir(dir);
-    std::fs::write(dir.join("scene.oct"), common::run_ok(&mut c)).unwrap();
-    let mut theirs = o.command("rtrace");
-    theirs.args(opts).arg("scene.oct").current_dir(dir);
-    let t = common::run_stdin(theirs, rays.as_bytes());
-    assert!(t.status.success(), "{}", String::from_utf8_lossy(&t.stderr));
-    let mut ours = common::fenestra("rtrace");
-    ours.args(opts).arg("scene.rad").current_dir(dir);
-    let f = common::run_stdin(ours, rays.as_bytes());
-    assert!(f.status.success(), "{}", String::from_utf8_lossy(&f.stderr));
-    let (t, f) = (common::numbers(&t.stdout), common::numbers(&f.stdout));
-    assert_eq!(t.len(), f.len());
-    (t, f)
-}
-
 /// Glowing surfaces only: each ray's value says which surface it ended on (red wall, green
 /// plate embedded in the wall behind recess e, blue background), so the values must be equal.
 #[test]
@@ -88,7 +70,7 @@ fn oracle_holes_and_recesses_are_seen_as_radiance_sees_them() {
     ]
     .join("\n")
         + "\n";
-    let (t, f) = both(&o, &dir, &["-h", "-ov"], &rays);
+    let (t, f) = common::both_rtrace(&o, &dir, &["-h", "-ov"], &rays);
     assert_eq!(t.len(), 30);
     assert_eq!(t, f, "oracle vs ours, RGB per ray");
     // the cases are not all the same surface
@@ -110,7 +92,7 @@ fn oracle_recess_bottom_is_lit_through_the_antimatter() {
     for outs in [["-ov"], ["-oN"]] {
         let mut opts = vec!["-h", "-ab", "0", "-dj", "0"];
         opts.extend(outs);
-        let (t, f) = both(&o, &dir, &opts, rays);
+        let (t, f) = common::both_rtrace(&o, &dir, &opts, rays);
         assert!(t.iter().any(|v| *v != 0.0));
         for (k, (a, b)) in t.iter().zip(&f).enumerate() {
             assert!(

@@ -9,31 +9,6 @@ fn run(cmd: Command, input: &str) -> std::process::Output {
     common::run_stdin(cmd, input.as_bytes())
 }
 
-/// Runs `scene.rad` in `dir` through the reference rtrace (after its oconv) and ours with
-/// the same options and rays; returns (theirs, ours), having checked both succeeded
-/// and gave as many numbers.
-fn both_rtrace(
-    oracle: &common::Oracle,
-    dir: &std::path::Path,
-    opts: &[&str],
-    rays: &str,
-) -> (Vec<f64>, Vec<f64>) {
-    let mut c = oracle.command("oconv");
-    c.arg("scene.rad").current_dir(dir);
-    std::fs::write(dir.join("scene.oct"), common::run_ok(&mut c)).unwrap();
-    let mut theirs = oracle.command("rtrace");
-    theirs.args(opts).arg("scene.oct").current_dir(dir);
-    let t = run(theirs, rays);
-    assert!(t.status.success(), "{}", String::from_utf8_lossy(&t.stderr));
-    let mut ours = common::fenestra("rtrace");
-    ours.args(opts).arg("scene.rad").current_dir(dir);
-    let o = run(ours, rays);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let (t, o) = (values(&t.stdout), values(&o.stdout));
-    assert_eq!(t.len(), o.len());
-    (t, o)
-}
-
 const CAL: &str = "{ test patterns }
 grad = 1 + Dz*Dz + A1*Dx;
 band(x) = if(sin(x*A2), 1, .25);
@@ -75,10 +50,6 @@ fn rays() -> String {
     s
 }
 
-fn values(out: &[u8]) -> Vec<f64> {
-    common::numbers(out)
-}
-
 #[test]
 fn oracle_cal_patterns_match_rtrace() {
     let Some(oracle) = common::oracle() else {
@@ -89,7 +60,7 @@ fn oracle_cal_patterns_match_rtrace() {
     std::fs::write(dir.join("scene.rad"), SCENE).unwrap();
     // -ab 0 and no jitter (-dj 0, -ds 0): direct light and sky values are deterministic.
     let opts = ["-h", "-ab", "0", "-dj", "0", "-ds", "0", "-u-"];
-    let (t, o) = both_rtrace(&oracle, &dir, &opts, &rays());
+    let (t, o) = common::both_rtrace(&oracle, &dir, &opts, &rays());
     assert!(t.iter().any(|v| *v > 0.0));
     for (k, (a, b)) in t.iter().zip(&o).enumerate() {
         // rtrace prints 6 significant digits and keeps colours in single precision.
@@ -145,7 +116,7 @@ fn oracle_pattern_transforms_match_rtrace() {
     let rays = "0.3 0.2 2 0.1 0.2 -1\n-1 0.5 3 0.3 -0.1 -1\n2 -1 1 -0.4 0.3 -1\n";
     for xf in ["-rz 30 -t 1 2 3 -s 2 -rx 20", "-s -2", "-mx -i 2 -rz 10"] {
         let nxf = xf.split_whitespace().count();
-        for (k, chunk) in vars.chunks(3).enumerate() {
+        for chunk in vars.chunks(3) {
             let mut cal = String::new();
             for c in 0..3 {
                 // offset 10 keeps every value positive (rtrace prints colours, not signs)
@@ -159,7 +130,7 @@ fn oracle_pattern_transforms_match_rtrace() {
                 4 + nxf
             );
             std::fs::write(dir.join("scene.rad"), scene).unwrap();
-            let (t, o) = both_rtrace(&oracle, &dir, &["-h", "-ab", "0", "-u-"], rays);
+            let (t, o) = common::both_rtrace(&oracle, &dir, &["-h", "-ab", "0", "-u-"], rays);
             assert_eq!(t.len(), 9);
             for (j, (a, b)) in t.iter().zip(&o).enumerate() {
                 // 6 printed digits; single-precision colours in Radiance.
@@ -183,7 +154,7 @@ fn oracle_pattern_transforms_match_rtrace() {
             k as f64 * 0.2 - 2.0
         ));
     }
-    let (t, o) = both_rtrace(&oracle, &dir, &["-h", "-ab", "0", "-u-"], &rays);
+    let (t, o) = common::both_rtrace(&oracle, &dir, &["-h", "-ab", "0", "-u-"], &rays);
     assert_eq!(t.len(), 60);
     for (k, (a, b)) in t.iter().zip(&o).enumerate() {
         assert!(
@@ -233,7 +204,7 @@ wall polygon back 0 0 12  -2 5 3  2 5 3  2 5 0  -2 5 0
         rays.push_str(&format!("0 0 1.5 {} 1 0\n", (k as f64 - 20.0) / 50.0));
     }
     let opts = ["-h", "-ab", "0", "-u-"];
-    let (t, o) = both_rtrace(&oracle, &dir, &opts, &rays);
+    let (t, o) = common::both_rtrace(&oracle, &dir, &opts, &rays);
     assert_eq!(t.len(), o.len());
     assert!(t.iter().filter(|v| **v > 0.0).count() > 100);
     for (k, (a, b)) in t.iter().zip(&o).enumerate() {
@@ -272,7 +243,7 @@ fn oracle_e_and_f_reach_patterns() {
     let rays: String = (0..10)
         .map(|k| format!("0 0 0 {} 0 1\n", k as f64 * 0.3))
         .collect();
-    let (t, o) = both_rtrace(&oracle, &dir, &opts, &rays);
+    let (t, o) = common::both_rtrace(&oracle, &dir, &opts, &rays);
     assert_eq!(t.len(), 30);
     for (a, b) in t.iter().zip(&o) {
         assert!(

@@ -137,3 +137,23 @@ pub fn numbers(out: &[u8]) -> Vec<f64> {
         })
         .collect()
 }
+
+/// Runs `scene.rad` in `dir` through the reference rtrace (after its oconv) and ours with
+/// the same options and rays; returns (theirs, ours), having checked both succeeded and
+/// gave as many numbers.
+pub fn both_rtrace(oracle: &Oracle, dir: &Path, opts: &[&str], rays: &str) -> (Vec<f64>, Vec<f64>) {
+    let mut c = oracle.command("oconv");
+    c.arg("scene.rad").current_dir(dir);
+    std::fs::write(dir.join("scene.oct"), run_ok(&mut c)).unwrap();
+    let mut theirs = oracle.command("rtrace");
+    theirs.args(opts).arg("scene.oct").current_dir(dir);
+    let t = run_stdin(theirs, rays.as_bytes());
+    assert!(t.status.success(), "{}", String::from_utf8_lossy(&t.stderr));
+    let mut ours = fenestra("rtrace");
+    ours.args(opts).arg("scene.rad").current_dir(dir);
+    let o = run_stdin(ours, rays.as_bytes());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (t, o) = (numbers(&t.stdout), numbers(&o.stdout));
+    assert_eq!(t.len(), o.len());
+    (t, o)
+}

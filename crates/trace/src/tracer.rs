@@ -595,19 +595,7 @@ impl Tracer {
         tracked: &[bool],
         sink: &mut impl FnMut(Contribution),
     ) -> [f64; 3] {
-        let d = dir.normalize_or_zero();
-        if d == DVec3::ZERO {
-            return [0.0; 3];
-        }
-        let mut cx = Ctx {
-            rng: Rng::for_ray(self.opts.seed, ray_index),
-            rays: 0,
-            tracked,
-            sink: Some(sink),
-        };
-        let v = self.trace(&Self::primary(org, d), &mut cx);
-        self.count(&cx);
-        v.to_array()
+        self.contributions_limited(ray_index, org, dir, f64::INFINITY, tracked, sink)
     }
 
     /// As [`contributions`](Self::contributions) for a ray that ends after `len` (rcontrib
