@@ -1,8 +1,12 @@
-//! The acceleration structure: an obvhs compressed-wide BVH over f32 boxes rounded
-//! outward, with every primitive test done in f64.
+//! The acceleration structure, with every primitive test done in f64: for a scene of at
+//! most [`FLAT_MAX`] shapes, all shape boxes (f64) are tested against each ray in one
+//! branch-free loop and only the shapes whose boxes the ray enters are intersected; a
+//! larger scene uses an obvhs compressed-wide BVH over f32 boxes rounded outward.
 //!
 //! Boxes are padded by a margin that covers the rounding of the f32 ray (origin and
 //! direction) used for traversal, so a surface the f64 test would hit is never culled.
+//! Neither path has a minimum distance: a surface a few µm from a ray's origin (a room's
+//! corner) is found.
 
 use glam::{DVec3, Vec3A};
 use obvhs::{aabb::Aabb, cwbvh::CwBvh, ray::Ray, Boundable, BvhBuildParams};
@@ -31,10 +35,56 @@ pub struct Accel {
     /// The shapes, indexed as the caller gave them.
     pub shapes: Vec<Shape>,
     bvh: Option<CwBvh>,
-    /// Below this many shapes a linear scan is used.
-    linear: bool,
+    /// For a small scene: every shape's box, tested all at once.
+    flat: Option<Flat>,
     /// Largest absolute coordinate of the scene (for relative epsilons).
     pub scale: f64,
+}
+
+/// How far behind its origin a ray enters the BVH (more than obvhs's 1e-4 minimum box
+/// distance).
+const BACK: f64 = 1e-3;
+
+/// Up to this many shapes, every shape's box is tested for each ray (a loop without
+/// branches the compiler vectorises) instead of traversing the BVH.
+const FLAT_MAX: usize = 32;
+
+/// Shape boxes (f64, padded) by coordinate, for scenes of at most [`FLAT_MAX`] shapes.
+struct Flat {
+    lo: [Vec<f64>; 3],
+    hi: [Vec<f64>; 3],
+}
+
+impl Flat {
+    /// The distance at which the ray `o + t d` (`inv` = 1/d, every component finite)
+    /// enters each box within [0, tmax], or ∞ where it does not.
+    #[inline(always)]
+    fn entries(&self, o: DVec3, inv: DVec3, tmax: f64, ent: &mut [f64]) {
+        let n = ent.len();
+        let (lx, ly, lz) = (&self.lo[0][..n], &self.lo[1][..n], &self.lo[2][..n]);
+        let (hx, hy, hz) = (&self.hi[0][..n], &self.hi[1][..n], &self.hi[2][..n]);
+        // plain comparisons (no NaN can arise: finite boxes, origin and inverse)
+        let mn = |a: f64, b: f64| if a < b { a } else { b };
+        let mx = |a: f64, b: f64| if a > b { a } else { b };
+        for i in 0..n {
+            let (ax, bx) = ((lx[i] - o.x) * inv.x, (hx[i] - o.x) * inv.x);
+            let (ay, by) = ((ly[i] - o.y) * inv.y, (hy[i] - o.y) * inv.y);
+            let (az, bz) = ((lz[i] - o.z) * inv.z, (hz[i] - o.z) * inv.z);
+            let t0 = mx(mx(mx(mn(ax, bx), mn(ay, by)), mn(az, bz)), 0.0);
+            let t1 = mn(mn(mn(mx(ax, bx), mx(ay, by)), mx(az, bz)), tmax);
+            ent[i] = if t0 <= t1 { t0 } else { f64::INFINITY };
+        }
+    }
+}
+
+/// 1/x with |x| raised to at least 1e-300, so the inverse is finite and a box test never
+/// meets 0 × ∞ (a ray parallel to an axis gets a slope of 1e-300 instead of 0).
+fn safe_inv(x: f64) -> f64 {
+    if x.abs() < 1e-300 {
+        1e300
+    } else {
+        1.0 / x
+    }
 }
 
 /// The next f32 towards +inf (f32::next_up needs Rust 1.86; MSRV is 1.85).
@@ -94,8 +144,12 @@ impl Accel {
                 ))
             })
             .collect();
-        let linear = shapes.len() < 4;
-        let bvh = (!linear).then(|| {
+        let small = shapes.len() <= FLAT_MAX;
+        let flat = small.then(|| Flat {
+            lo: [0, 1, 2].map(|a| bounds.iter().map(|(lo, _)| lo[a] - pad).collect()),
+            hi: [0, 1, 2].map(|a| bounds.iter().map(|(_, hi)| hi[a] + pad).collect()),
+        });
+        let bvh = (!small).then(|| {
             obvhs::cwbvh::builder::build_cwbvh(
                 &prims,
                 BvhBuildParams::medium_build(),
@@ -105,9 +159,28 @@ impl Accel {
         Accel {
             shapes,
             bvh,
-            linear,
+            flat,
             scale,
         }
+    }
+
+    /// The f32 ray the BVH is traversed with: started `BACK` behind `org`, since obvhs's
+    /// traversal skips boxes the ray leaves within its first 1e-4 (a surface a few µm from
+    /// the origin, as in a room's corner, would be missed); its limit covers `tmax`.
+    fn box_ray(&self, org: DVec3, dir: DVec3, tmax: f64) -> Ray {
+        let o = org - dir * BACK;
+        Ray::new(
+            Vec3A::new(o.x as f32, o.y as f32, o.z as f32),
+            // +0.0 turns -0.0 into 0.0: obvhs inverts the sign of a zero
+            // component but tests `< 0`, so -0.0 would miss every box.
+            Vec3A::new(dir.x as f32 + 0.0, dir.y as f32 + 0.0, dir.z as f32 + 0.0),
+            0.0,
+            if tmax.is_finite() {
+                up(tmax * (1.0 + 1e-6) + 4e-6 * self.scale + BACK)
+            } else {
+                f32::INFINITY
+            },
+        )
     }
 
     /// Closest hit in (tmin, tmax) for a unit direction, skipping shape `skip`.
@@ -139,37 +212,41 @@ impl Accel {
                 }
             }
         };
-        match &self.bvh {
-            None => {
-                if self.linear {
-                    for i in 0..self.shapes.len() {
+        match (&self.flat, &self.bvh) {
+            (Some(flat), _) => {
+                let mut ent = [0.0f64; FLAT_MAX];
+                let ent = &mut ent[..self.shapes.len()];
+                let inv = DVec3::new(safe_inv(dir.x), safe_inv(dir.y), safe_inv(dir.z));
+                let slack = 4e-6 * self.scale;
+                let box_max = if tmax.is_finite() {
+                    tmax * (1.0 + 1e-6) + slack
+                } else {
+                    f64::INFINITY
+                };
+                flat.entries(org, inv, box_max, ent);
+                let mut lim = box_max;
+                for (i, &e) in ent.iter().enumerate() {
+                    if e <= lim && e < f64::INFINITY {
                         test(i, &mut best);
+                        if let Some(b) = best {
+                            lim = b.t * (1.0 + 1e-6) + slack;
+                        }
                     }
                 }
             }
-            Some(bvh) => {
-                let ray = Ray::new(
-                    Vec3A::new(org.x as f32, org.y as f32, org.z as f32),
-                    // +0.0 turns -0.0 into 0.0: obvhs inverts the sign of a zero
-                    // component but tests `< 0`, so -0.0 would miss every box.
-                    Vec3A::new(dir.x as f32 + 0.0, dir.y as f32 + 0.0, dir.z as f32 + 0.0),
-                    0.0,
-                    if tmax.is_finite() {
-                        up(tmax * (1.0 + 1e-6) + 4e-6 * self.scale)
-                    } else {
-                        f32::INFINITY
-                    },
-                );
+            (None, Some(bvh)) => {
+                let ray = self.box_ray(org, dir, tmax);
                 let mut rh = obvhs::ray::RayHit::none();
                 bvh.ray_traverse(ray, &mut rh, |_r, id| {
                     let i = bvh.primitive_indices[id] as usize;
                     test(i, &mut best);
                     match best {
-                        Some(b) => up(b.t * (1.0 + 1e-6) + 4e-6 * self.scale),
+                        Some(b) => up(b.t * (1.0 + 1e-6) + 4e-6 * self.scale + BACK),
                         None => f32::INFINITY,
                     }
                 });
             }
+            (None, None) => {}
         }
         best
     }
@@ -186,19 +263,23 @@ impl Accel {
     ) -> bool {
         let test =
             |i: usize| Some(i) != skip && self.shapes[i].intersect(org, dir, tmin, tmax).is_some();
-        match &self.bvh {
-            None => (0..self.shapes.len()).any(test),
-            Some(bvh) => {
-                let ray = Ray::new(
-                    Vec3A::new(org.x as f32, org.y as f32, org.z as f32),
-                    Vec3A::new(dir.x as f32 + 0.0, dir.y as f32 + 0.0, dir.z as f32 + 0.0),
-                    0.0,
-                    if tmax.is_finite() {
-                        up(tmax * (1.0 + 1e-6) + 4e-6 * self.scale)
-                    } else {
-                        f32::INFINITY
-                    },
-                );
+        match (&self.flat, &self.bvh) {
+            (Some(flat), _) => {
+                let mut ent = [0.0f64; FLAT_MAX];
+                let ent = &mut ent[..self.shapes.len()];
+                let inv = DVec3::new(safe_inv(dir.x), safe_inv(dir.y), safe_inv(dir.z));
+                let box_max = if tmax.is_finite() {
+                    tmax * (1.0 + 1e-6) + 4e-6 * self.scale
+                } else {
+                    f64::INFINITY
+                };
+                flat.entries(org, inv, box_max, ent);
+                ent.iter()
+                    .enumerate()
+                    .any(|(i, &e)| e < f64::INFINITY && test(i))
+            }
+            (None, Some(bvh)) => {
+                let ray = self.box_ray(org, dir, tmax);
                 !bvh.ray_traverse_miss(ray, |_r, id| {
                     if test(bvh.primitive_indices[id] as usize) {
                         0.0
@@ -207,6 +288,7 @@ impl Accel {
                     }
                 })
             }
+            (None, None) => false,
         }
     }
 
@@ -268,6 +350,119 @@ mod tests {
             nhit += usize::from(got.is_some());
         }
         assert!(nhit > 50, "{nhit}");
+    }
+
+    /// Brute force: closest over all shapes (lowest index on a tie).
+    fn brute(shapes: &[Shape], org: DVec3, dir: DVec3, tmin: f64) -> Option<(f64, usize)> {
+        shapes
+            .iter()
+            .enumerate()
+            .filter_map(|(i, s)| s.intersect(org, dir, tmin, f64::INFINITY).map(|t| (t, i)))
+            .min_by(|a, b| a.partial_cmp(b).unwrap())
+    }
+
+    #[test]
+    fn flat_box_test_matches_brute_force() {
+        // a closed box room (12 triangles) plus a few quads: the flat path, including rays
+        // along the axes (zero direction components) and rays starting on a face
+        let c = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+        let tri =
+            |a: DVec3, b: DVec3, d: DVec3| Shape::Polygon(Polygon::new(vec![a, b, d]).unwrap().0);
+        let mut shapes = Vec::new();
+        let (x1, y1, z1) = (4.0, 5.0, 3.0);
+        let faces = [
+            [c(0., 0., 0.), c(x1, 0., 0.), c(x1, y1, 0.), c(0., y1, 0.)],
+            [c(0., 0., z1), c(0., y1, z1), c(x1, y1, z1), c(x1, 0., z1)],
+            [c(0., 0., 0.), c(0., y1, 0.), c(0., y1, z1), c(0., 0., z1)],
+            [c(x1, 0., 0.), c(x1, 0., z1), c(x1, y1, z1), c(x1, y1, 0.)],
+            [c(0., 0., 0.), c(0., 0., z1), c(x1, 0., z1), c(x1, 0., 0.)],
+            [c(0., y1, 0.), c(x1, y1, 0.), c(x1, y1, z1), c(0., y1, z1)],
+        ];
+        for f in faces {
+            shapes.push(tri(f[0], f[1], f[2]));
+            shapes.push(tri(f[0], f[2], f[3]));
+        }
+        for k in 0..5 {
+            shapes.push(quad(
+                c(0.5 + 0.6 * k as f64, 2.0, 0.5 + 0.4 * k as f64),
+                0.3,
+                0.2,
+            ));
+        }
+        let acc = Accel::new(shapes.clone());
+        assert!(acc.flat.is_some());
+        let mut rng = crate::rng::Rng::for_ray(11, 3);
+        let mut hits = 0;
+        for k in 0..4000 {
+            let org = c(
+                rng.next_f64() * x1,
+                rng.next_f64() * y1,
+                if k % 4 == 0 { 0.0 } else { rng.next_f64() * z1 },
+            );
+            let dir = match k % 5 {
+                0 => [DVec3::X, -DVec3::Y, DVec3::Z, -DVec3::Z][k / 5 % 4],
+                _ => c(
+                    rng.next_f64() - 0.5,
+                    rng.next_f64() - 0.5,
+                    rng.next_f64() - 0.5,
+                )
+                .normalize(),
+            };
+            let tmin = 1e-9 * (1.0 + org.abs().max_element());
+            let got = acc
+                .closest(org, dir, tmin, f64::INFINITY, None)
+                .map(|h| (h.t, h.shape));
+            assert_eq!(got, brute(&shapes, org, dir, tmin), "ray {k}");
+            if org.z > 0.0 {
+                hits += usize::from(got.is_some());
+            }
+            let occ = acc.occluded(org, dir, tmin, 1.0, None);
+            let want = brute(&shapes, org, dir, tmin).is_some_and(|(t, _)| t < 1.0);
+            assert_eq!(occ, want, "occlusion of ray {k}");
+        }
+        // inside the closed room every ray starting off the floor hits something
+        assert_eq!(hits, 3000);
+    }
+
+    #[test]
+    fn surface_microns_from_the_origin_is_found() {
+        // A ray leaving a ceiling 3.5 µm from the wall it heads into meets that wall after
+        // 4 µm. (obvhs's traversal skips boxes left within 1e-4 of the ray's start; the
+        // BVH path starts its ray behind the origin to make up for it.)
+        for extra in [0, 60] {
+            let wall = Shape::Polygon(
+                Polygon::new(vec![
+                    DVec3::ZERO,
+                    DVec3::new(0.0, 5.0, 0.0),
+                    DVec3::new(0.0, 5.0, 3.0),
+                    DVec3::new(0.0, 0.0, 3.0),
+                ])
+                .unwrap()
+                .0,
+            );
+            let mut shapes = vec![wall];
+            // (small quads under the floor, keeping the scene's size and so the boxes' padding)
+            for k in 0..extra {
+                let (i, j) = ((k % 8) as f64, (k / 8) as f64);
+                shapes.push(quad(
+                    DVec3::new(1.0 + 0.4 * i, 1.0 + 0.4 * j, -1.0),
+                    0.1,
+                    0.1,
+                ));
+            }
+            let acc = Accel::new(shapes);
+            assert_eq!(acc.flat.is_some(), extra == 0);
+            let org = DVec3::new(3.5e-6, 0.44, 3.0);
+            let dir = DVec3::new(-0.875, 0.171, -0.4525).normalize();
+            let h = acc.closest(org, dir, 4e-9, f64::INFINITY, None).unwrap();
+            assert_eq!(h.shape, 0);
+            assert!(
+                (h.t - 3.5e-6 / 0.875 * dir.length()).abs() < 1e-7,
+                "{}",
+                h.t
+            );
+            assert!(acc.occluded(org, dir, 4e-9, 1.0, None));
+        }
     }
 
     #[test]
