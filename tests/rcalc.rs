@@ -546,7 +546,8 @@ fn oracle_generated_corpus() {
 }
 
 /// Blocks of records evaluated on several threads give the output of one thread, in
-/// the same order, with the same warnings and the same stop at an error (the input is
+/// the same order, with the same warnings and the same stop at an error, and so does
+/// `-u` (records read and written one by one) (the input is
 /// about 12 blocks of 256 KB, with warnings, `cond`, blank lines and a line without
 /// its newline at the end).
 #[test]
@@ -593,11 +594,23 @@ fn threads_give_the_output_of_one_thread() {
             },
             input.as_bytes(),
         );
+        // -u: record by record, the output flushed after each
+        let flushed = run_with(
+            {
+                let mut c = ours(&[&["-u"], args].concat());
+                c.env("FENESTRA_RCALC_THREADS", "1");
+                c
+            },
+            input.as_bytes(),
+        );
         assert!(
             one.1.len() > 100_000,
             "{args:?}: {} bytes of output",
             one.1.len()
         );
+        assert_eq!(one.0, flushed.0, "{args:?}: exit status with -u");
+        assert!(one.1 == flushed.1, "{args:?}: outputs differ with -u");
+        assert_eq!(one.2, flushed.2, "{args:?}: messages differ with -u");
         assert_eq!(one.0, !args[1].contains("f(1)"), "{args:?}: exit status");
         assert_eq!(one.0, three.0, "{args:?}: exit status");
         assert!(one.1 == three.1, "{args:?}: outputs differ");

@@ -235,6 +235,12 @@ impl State {
         self.errno_writes != writes
     }
 
+    /// Whether warnings were counted since the last [`State::take_warnings`].
+    #[inline]
+    pub fn has_warnings(&self) -> bool {
+        self.warnings.any()
+    }
+
     /// Returns and clears the warnings counted so far.
     pub fn take_warnings(&mut self) -> Warnings {
         std::mem::take(&mut self.warnings)

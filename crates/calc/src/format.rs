@@ -34,11 +34,19 @@ pub fn fmt_g(x: f64, prec: usize) -> String {
 pub fn push_g(out: &mut Vec<u8>, x: f64, prec: usize, scratch: &mut String) {
     use std::fmt::Write;
     let p = prec.max(1);
-    if !x.is_finite() || x == 0.0 || p > 17 {
+    if x == 0.0 {
+        out.extend_from_slice(if x.is_sign_negative() { b"-0" } else { b"0" });
+        return;
+    }
+    if !x.is_finite() || p > 17 {
         out.extend_from_slice(fmt_g(x, prec).as_bytes());
         return;
     }
-    if x.fract() == 0.0 && x.abs() < 10f64.powi(p as i32) {
+    const POW10: [f64; 18] = [
+        1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+        1e17,
+    ];
+    if x.fract() == 0.0 && x.abs() < POW10[p] {
         // an integer of at most `p` digits prints as itself
         let mut n = x.abs() as u64;
         let mut d = [0u8; 20];
