@@ -1614,13 +1614,28 @@ impl Tracer {
         let (a, b) = frame(nrm);
         let skip = shape.filter(|&s| self.accel.shapes[s].is_flat());
         let mut sum = DVec3::ZERO;
-        for i in 0..n {
-            for j in 0..n {
-                let x = (j as f64 + cx.rng.next_f64()) / n as f64;
-                let y = (i as f64 + cx.rng.next_f64()) / n as f64;
+        // Directions are drawn a batch at a time (stratum by stratum, row-major), then
+        // traced: the batch's arithmetic runs without waiting on each ray's tracing.
+        let nf = n as f64;
+        let total = n * n;
+        let (mut i, mut j) = (0usize, 0usize);
+        let mut dirs = [DVec3::ZERO; AMB_BATCH];
+        let mut done = 0;
+        while done < total {
+            let m = (total - done).min(AMB_BATCH);
+            for d in dirs.iter_mut().take(m) {
+                let x = (j as f64 + cx.rng.next_f64()) / nf;
+                let y = (i as f64 + cx.rng.next_f64()) / nf;
+                j += 1;
+                if j == n {
+                    j = 0;
+                    i += 1;
+                }
                 let (u, v) = square_to_disk(x, y);
                 let z = (1.0 - u * u - v * v).max(0.0).sqrt();
-                let dir = (a * u + b * v + nrm * z).normalize();
+                *d = (a * u + b * v + nrm * z).normalize();
+            }
+            for &dir in &dirs[..m] {
                 let mut rc = acoef;
                 let mut c = self.child(r, p, dir, AMBIENT, rc, skip, 0.0);
                 c.amb = r.amb + 1;
@@ -1629,10 +1644,14 @@ impl Tracer {
                 }
                 sum += rc * self.trace(&c, cx);
             }
+            done += m;
         }
         sum
     }
 }
+
+/// Ambient directions drawn ahead of tracing (see [`Tracer::ambient`]).
+const AMB_BATCH: usize = 16;
 
 /// Shirley–Chiu concentric map of the unit square onto the unit disk.
 fn square_to_disk(x: f64, y: f64) -> (f64, f64) {
@@ -1640,11 +1659,11 @@ fn square_to_disk(x: f64, y: f64) -> (f64, f64) {
     if a == 0.0 && b == 0.0 {
         return (0.0, 0.0);
     }
-    let (r, phi) = if a * a > b * b {
-        (a, (PI / 4.0) * (b / a))
-    } else {
-        (b, PI / 2.0 - (PI / 4.0) * (a / b))
-    };
+    // one division and selects instead of branches (the branch is a coin toss)
+    let outer_a = a * a > b * b;
+    let (r, num) = if outer_a { (a, b) } else { (b, a) };
+    let q = (PI / 4.0) * (num / r);
+    let phi = if outer_a { q } else { PI / 2.0 - q };
     (r * phi.cos(), r * phi.sin())
 }
 
