@@ -41,10 +41,13 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     }
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
+    // One colour-dither generator for the whole run, as in a Radiance process.
+    let mut rng = fenestra_bsdf::radiance::Drand48::new();
     for f in &files {
         let path = fenestra_cli::raypath::find(f).unwrap_or_else(|| Path::new(f).into());
         let b = fenestra_bsdf::read_file(&path).map_err(|e| anyhow!("{e}"))?;
-        let text = report(f, &b)?;
+        let colour = fenestra_bsdf::radiance::colour_lambertians(&b, &mut rng);
+        let text = report(f, &b, &colour)?;
         out.write_all(text.as_bytes())?;
         out.flush()?;
     }
@@ -80,8 +83,8 @@ fn data_type(b: &Bsdf) -> String {
     }
 }
 
-/// The report for one file.
-fn report(name: &str, b: &Bsdf) -> Result<String> {
+/// The report for one file (`colour`: the coloured Lambertian parts split off on loading).
+fn report(name: &str, b: &Bsdf, colour: &[(Direction, [f64; 3])]) -> Result<String> {
     let mut s = String::new();
     s.push_str("=====================================================\n");
     writeln!(s, "File: '{name}'")?;
@@ -110,7 +113,7 @@ fn report(name: &str, b: &Bsdf) -> Result<String> {
         if tree {
             check::tree_component(b, d)
         } else {
-            check::component(b, d)
+            check::component_with(b, d, colour)
         }
     };
     let (rf, rb) = (
@@ -139,11 +142,34 @@ fn report(name: &str, b: &Bsdf) -> Result<String> {
     };
     row(&mut s, "Interior Refl", &rf);
     row(&mut s, "Exterior Refl", &rb);
-    row(&mut s, "Int->Ext Trans", &tf);
+    // Radiance keeps one Lambertian transmission for both sides: a missing transmission
+    // component shows the other's, with that part's Y (a fraction, printed as is) as its largest
+    // directional total.
+    let shared = |c: &Option<ComponentCheck>| {
+        c.as_ref()
+            .filter(|c| c.lambertian_xyz[1] > 0.0)
+            .map(|c| (c.lambertian_xyz, c.lambertian_xyz[1] / 100.0, 180.0f64))
+    };
+    let trow =
+        |s: &mut String, label: &str, c: &Option<ComponentCheck>, other| match (c, shared(other)) {
+            (None, Some((l, m, a))) => {
+                let _ = writeln!(
+                    s,
+                    "{label}\t{:4.1} {:4.1} {:4.1}\t\t{:5.1}%\t\t{} deg",
+                    100.0 * l[0],
+                    100.0 * l[1],
+                    100.0 * l[2],
+                    100.0 * m,
+                    g(a, 3)
+                );
+            }
+            _ => row(s, label, c),
+        };
+    trow(&mut s, "Int->Ext Trans", &tf, &tb);
     if tf.is_none() && tb.is_none() {
         s.push_str("Ext->Int Trans\t 0    0    0\t\t  0.0%\t\t180 deg\n");
     } else {
-        row(&mut s, "Ext->Int Trans", &tb);
+        trow(&mut s, "Ext->Int Trans", &tb, &tf);
     }
     s.push_str("Component\tReciprocity Error (min avg max %)\n");
     if tree {

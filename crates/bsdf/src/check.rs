@@ -5,10 +5,10 @@
 //! Conventions (learned by running Radiance's checkBSDF): Radiance's "Interior Refl" is the
 //! XML `Reflection Back`, "Exterior Refl" `Reflection Front`, "Int->Ext Trans"
 //! `Transmission Back`, "Ext->Int Trans" `Transmission Front`. Values are the `Visible`
-//! (CIE Y) blocks. The reciprocity error of an element pair is `|a − b| / max(a, b)` (0 when
-//! both are 0) between `f(o ← i)` and `f'(rot(i) ← rot(o))`, rot = the same-ring patch turned
-//! by 180°, `f' = f` for reflection and `f'` = the opposite transmission block; min, mean and
-//! max are over all element pairs.
+//! (CIE Y) blocks. The reciprocity error of an element pair is `|a − b| / max(a, b)` between
+//! `f(o ← i)` and `f'(rot(i) ← rot(o))`, rot = the same-ring patch turned by 180°, `f' = f` for
+//! reflection and `f'` = the opposite transmission block; min, mean and max are over all element
+//! pairs without a zero element.
 
 use crate::klems::KlemsBasis;
 use crate::model::{Bsdf, Direction, KlemsMatrix, Wavelength};
@@ -45,18 +45,34 @@ pub struct Reciprocity {
     pub max: f64,
 }
 
-/// Summarises the `Visible` Klems matrix of `d`, `None` when the file has none.
+/// Summarises the `Visible` Klems matrix of `d`, `None` when the file has none (the file
+/// loaded first in a process, for the colour dither; see [`component_with`]).
 pub fn component(b: &Bsdf, d: Direction) -> Option<ComponentCheck> {
+    let colour = crate::radiance::colour_lambertians(b, &mut crate::radiance::Drand48::new());
+    component_with(b, d, &colour)
+}
+
+/// [`component`] with the coloured Lambertian parts Radiance splits off this file, from
+/// [`crate::radiance::colour_lambertians`] with the process's dither generator. A coloured
+/// component (CIE-X and CIE-Z blocks) reports π × that part's CIE XYZ (zero when nothing is split
+/// off); a grey one π × its minimum when above [`LAMBERTIAN_MIN`].
+pub fn component_with(
+    b: &Bsdf,
+    d: Direction,
+    colour: &[(Direction, [f64; 3])],
+) -> Option<ComponentCheck> {
     let y = b.klems(d, &Wavelength::Visible)?;
     let min_of = |m: &KlemsMatrix| m.values.iter().copied().fold(f64::INFINITY, f64::min);
     let ymin = min_of(y);
-    let lambertian_xyz = if ymin > LAMBERTIAN_MIN {
-        let pick = |w: Wavelength| b.klems(d, &w).map(min_of).unwrap_or(ymin);
-        [
-            std::f64::consts::PI * pick(Wavelength::CieX),
-            std::f64::consts::PI * ymin,
-            std::f64::consts::PI * pick(Wavelength::CieZ),
-        ]
+    let coloured =
+        b.klems(d, &Wavelength::CieX).is_some() && b.klems(d, &Wavelength::CieZ).is_some();
+    let lambertian_xyz = if coloured {
+        colour
+            .iter()
+            .find(|(c, _)| *c == d)
+            .map_or([0.0; 3], |(_, xyz)| xyz.map(|v| std::f64::consts::PI * v))
+    } else if ymin > LAMBERTIAN_MIN {
+        [std::f64::consts::PI * ymin; 3]
     } else {
         [0.0; 3]
     };
@@ -101,20 +117,25 @@ pub fn reciprocity(f: &KlemsMatrix, g: &KlemsMatrix) -> Option<Reciprocity> {
     let rot_o: Vec<usize> = (0..no)
         .map(|o| f.outgoing.rotate180(o).unwrap_or(o))
         .collect();
-    let (mut lo, mut hi, mut sum) = (f64::INFINITY, 0.0f64, 0.0);
+    let (mut lo, mut hi, mut sum, mut count) = (f64::INFINITY, 0.0f64, 0.0, 0usize);
     for (o, &ro) in rot_o.iter().enumerate() {
         for (i, &ri) in rot_i.iter().enumerate() {
             // g's outgoing index rot(i) lives in f's incident basis, its incident rot(o) in f's outgoing.
-            let e = pair_error(f.get(o, i), g.get(ri, ro));
+            let (a, b) = (f.get(o, i), g.get(ri, ro));
+            // Radiance leaves out pairs with a zero element (found on a matrix with zeros).
+            if a == 0.0 || b == 0.0 {
+                continue;
+            }
+            let e = pair_error(a, b);
             lo = lo.min(e);
             hi = hi.max(e);
             sum += e;
+            count += 1;
         }
     }
-    let n = (ni * no).max(1) as f64;
     Some(Reciprocity {
         min: if lo.is_finite() { lo } else { 0.0 },
-        mean: sum / n,
+        mean: sum / count.max(1) as f64,
         max: hi,
     })
 }
