@@ -217,10 +217,10 @@ const POW10: [f64; 23] = [
 #[inline(always)]
 fn plain_at(buf: &[u8], mut i: usize) -> Option<(f64, usize)> {
     let n = buf.len();
-    let neg = i < n && buf[i] == b'-';
-    if i < n && (neg || buf[i] == b'+') {
-        i += 1;
-    }
+    // (no branch on the sign: it is unpredictable in typical input)
+    let c = buf.get(i).copied().unwrap_or(0);
+    let neg = c == b'-';
+    i += usize::from(neg | (c == b'+'));
     let (mut m, mut nd, mut frac) = (0u64, 0u32, 0usize);
     i = digit_run(buf, i, &mut m, &mut nd);
     if i < n && buf[i] == b'.' {
@@ -232,7 +232,7 @@ fn plain_at(buf: &[u8], mut i: usize) -> Option<(f64, usize)> {
         return None;
     }
     let v = m as f64 / POW10[frac];
-    Some((if neg { -v } else { v }, i))
+    Some((f64::from_bits(v.to_bits() | u64::from(neg) << 63), i))
 }
 
 /// Reads the digits at `buf[i..]` into `m` (`nd` counts them), eight at a time where
