@@ -50,6 +50,48 @@ fn bench(label: &str, setup: &str, file: &str, expr: &str, ds: &[[f64; 3]]) {
     );
 }
 
+/// For scale: `rbin` of reinhart.cal with MF 1 written directly in Rust (the same
+/// operations: asin, atan2, floors, divisions), timed like the evaluator.
+fn native_rbin(ds: &[[f64; 3]]) {
+    const TNAZ: [f64; 8] = [30.0, 30.0, 24.0, 24.0, 18.0, 12.0, 6.0, 1.0];
+    const TSUM: [f64; 8] = [0.0, 30.0, 60.0, 84.0, 108.0, 126.0, 138.0, 144.0];
+    let deg = 180.0 / std::f64::consts::PI;
+    let alpha = 90.0 / (7.0 + 0.5);
+    let rbin = |d: &[f64; 3]| -> f64 {
+        let z = d[2].clamp(-1.0, 1.0);
+        let alt = deg * z.asin();
+        if -alt > 0.0 {
+            return 0.0;
+        }
+        let a0 = deg * d[0].atan2(d[1]);
+        let azi = if a0 > 0.0 { a0 } else { a0 + 360.0 };
+        let row = (alt / alpha).floor();
+        let r = row as usize;
+        let naz = if row - 6.5 > 0.0 { 1.0 } else { TNAZ[r.min(7)] };
+        let inc = 360.0 / naz;
+        let col = if 359.9999 - 0.5 * inc - azi > 0.0 {
+            ((azi + 0.5 * inc) / inc).floor()
+        } else {
+            0.0
+        };
+        TSUM[r.min(7)] + col + 1.0
+    };
+    let mut best = 0.0f64;
+    let mut sum = 0.0;
+    for _ in 0..5 {
+        let t = Instant::now();
+        for d in ds {
+            sum += rbin(std::hint::black_box(d));
+        }
+        best = best.max(ds.len() as f64 / t.elapsed().as_secs_f64());
+    }
+    println!(
+        "{:6} {:8.2} M evaluations/s (plain Rust for scale; checksum {sum})",
+        "rbin*",
+        best / 1e6
+    );
+}
+
 fn main() {
     let n: usize = std::env::args()
         .nth(1)
@@ -59,4 +101,5 @@ fn main() {
     bench("rbin", "MF:1", "reinhart.cal", "rbin", &ds);
     bench("kbin", "", "klems_full.cal", "kbin(0,1,0,0,0,1)", &ds);
     bench("kbinS", "", "klems_full.cal", "kbinS", &ds);
+    native_rbin(&ds);
 }
