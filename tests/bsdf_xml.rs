@@ -439,19 +439,42 @@ fn oracle_colour_dither_reproduced() {
     }
 }
 
-/// A coloured component from which Radiance splits a Lambertian part (no zero element): how
-/// Radiance colours the split part and re-encodes the remainder is not reproduced (channels
-/// differ by up to 55%, see docs/tools/checkBSDF.md), but the luminance is: to 2e-6 relative
-/// (float32 storage and single-precision steps, as above).
+/// A coloured component from which Radiance splits a Lambertian part (no zero element). The
+/// luminance is exact: to 2e-6 relative (float32 storage and single-precision steps, as above).
+/// The channels follow Radiance's split (per-channel minima in Sharp RGB, remainders quantised
+/// again; crates/bsdf/src/radiance.rs) but not exactly: our Lambertian colour differs from the
+/// oracle's by up to 5e-4 per channel (cause not found), which puts the remainders of about 1%
+/// of the elements, those whose chromaticity lies within ~0.02 of a 1/410 step boundary, one
+/// step off (up to 6% in a channel of a small remainder). Measured: 99% of the elements within
+/// 4.9e-4 per channel, all within 6.0%; asserted: 99% within 1e-3 and all within 10% (a wrong
+/// dither order or split space puts half the elements beyond 1e-3; before the split was
+/// reproduced, channels differed by up to 55%).
 #[test]
-fn oracle_colour_with_lambertian_part_keeps_luminance() {
+fn oracle_colour_with_lambertian_part() {
     let Some(o) = common::oracle() else { return };
     let dir = common::scratch("bsdf-colour-split");
     let p = coloured_xml(&dir, true);
     let t = transmission_matrix(&read_file(&p).unwrap()).unwrap();
-    let worst = worst_matrix_difference("split", &t, &oracle_matrix(&o, &p), true);
+    let theirs = oracle_matrix(&o, &p);
+    let worst = worst_matrix_difference("split", &t, &theirs, true);
     eprintln!(
         "Transmission Front with a Lambertian part: max relative luminance difference {worst:.2e}"
     );
     assert!(worst < 2e-6, "luminance differs by {worst:e}");
+    let mut per_element: Vec<f64> = theirs
+        .2
+        .iter()
+        .zip(&t.data)
+        .map(|(w, g)| {
+            (0..3)
+                .map(|ch| (g[ch] / w[ch] as f64 - 1.0).abs())
+                .fold(0.0, f64::max)
+        })
+        .collect();
+    per_element.sort_by(f64::total_cmp);
+    let q99 = per_element[per_element.len() * 99 / 100];
+    let max = per_element[per_element.len() - 1];
+    eprintln!("channels: 99% of elements within {q99:.2e}, all within {max:.2e}");
+    assert!(q99 < 1e-3, "99th percentile {q99:e}");
+    assert!(max < 0.1, "worst element {max:e}");
 }

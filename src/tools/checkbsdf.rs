@@ -201,7 +201,12 @@ fn report(name: &str, b: &Bsdf, colour: &[(Direction, [f64; 3])]) -> Result<Stri
             "Exterior Refl",
             check::reflection_reciprocity(b, Direction::ReflectionFront),
         );
-        rec(&mut s, "Transmission", check::transmission_reciprocity(b));
+        let lamb = |c: &Option<ComponentCheck>| c.as_ref().map_or(0.0, |c| c.lambertian_y);
+        rec(
+            &mut s,
+            "Transmission",
+            check::transmission_reciprocity_with(b, lamb(&tb), lamb(&tf)),
+        );
     }
 
     // fenestra's own section.

@@ -22,6 +22,8 @@ pub struct ComponentCheck {
     /// Lambertian part as CIE X, Y, Z hemispherical fractions (π × minimum; 0 below
     /// [`LAMBERTIAN_MIN`]).
     pub lambertian_xyz: [f64; 3],
+    /// The Lambertian part's CIE Y as a BSDF value (sr⁻¹; 0 when nothing is split off).
+    pub lambertian_y: f64,
     /// Largest directional-hemispherical total over incident patches (fraction).
     pub max_total: f64,
     /// Angular resolution in degrees: `2·√(λ_min/π)` for the smallest projected solid angle.
@@ -66,16 +68,17 @@ pub fn component_with(
     let ymin = min_of(y);
     let coloured =
         b.klems(d, &Wavelength::CieX).is_some() && b.klems(d, &Wavelength::CieZ).is_some();
-    let lambertian_xyz = if coloured {
+    let lambertian = if coloured {
         colour
             .iter()
             .find(|(c, _)| *c == d)
-            .map_or([0.0; 3], |(_, xyz)| xyz.map(|v| std::f64::consts::PI * v))
+            .map_or([0.0; 3], |(_, xyz)| *xyz)
     } else if ymin > LAMBERTIAN_MIN {
-        [std::f64::consts::PI * ymin; 3]
+        [ymin; 3]
     } else {
         [0.0; 3]
     };
+    let lambertian_xyz = lambertian.map(|v| std::f64::consts::PI * v);
     let totals: Vec<f64> = (0..y.incident.len()).map(|i| y.hemispherical(i)).collect();
     let max_total = totals.iter().copied().fold(0.0, f64::max);
     let lmin = |k: &KlemsBasis| k.lambdas().into_iter().fold(f64::INFINITY, f64::min);
@@ -86,6 +89,7 @@ pub fn component_with(
         totals.iter().zip(&lam_in).map(|(t, l)| t * l).sum::<f64>() / std::f64::consts::PI;
     Some(ComponentCheck {
         lambertian_xyz,
+        lambertian_y: lambertian[1],
         max_total,
         min_angle_deg,
         normal_total: totals.first().copied().unwrap_or(0.0),
@@ -107,6 +111,11 @@ fn pair_error(a: f64, b: f64) -> f64 {
 /// the bases do not allow the pairing (g's outgoing basis must be f's incident one and
 /// vice versa).
 pub fn reciprocity(f: &KlemsMatrix, g: &KlemsMatrix) -> Option<Reciprocity> {
+    reciprocity_shifted(f, g, 0.0)
+}
+
+/// [`reciprocity`] with `shift` added to every value of `g`.
+fn reciprocity_shifted(f: &KlemsMatrix, g: &KlemsMatrix, shift: f64) -> Option<Reciprocity> {
     if f.incident != g.outgoing || f.outgoing != g.incident {
         return None;
     }
@@ -121,7 +130,7 @@ pub fn reciprocity(f: &KlemsMatrix, g: &KlemsMatrix) -> Option<Reciprocity> {
     for (o, &ro) in rot_o.iter().enumerate() {
         for (i, &ri) in rot_i.iter().enumerate() {
             // g's outgoing index rot(i) lives in f's incident basis, its incident rot(o) in f's outgoing.
-            let (a, b) = (f.get(o, i), g.get(ri, ro));
+            let (a, b) = (f.get(o, i), g.get(ri, ro) + shift);
             // Radiance leaves out pairs with a zero element (found on a matrix with zeros).
             if a == 0.0 || b == 0.0 {
                 continue;
@@ -146,11 +155,26 @@ pub fn reflection_reciprocity(b: &Bsdf, d: Direction) -> Option<Reciprocity> {
     reciprocity(m, m)
 }
 
-/// Reciprocity between the two transmission components (`None` unless both exist).
+/// Reciprocity between the two transmission components (`None` unless both exist), with the
+/// Lambertian parts of the file loaded first in a process (see
+/// [`transmission_reciprocity_with`]).
 pub fn transmission_reciprocity(b: &Bsdf) -> Option<Reciprocity> {
+    let l = |d| component(b, d).map_or(0.0, |c| c.lambertian_y);
+    transmission_reciprocity_with(
+        b,
+        l(Direction::TransmissionFront),
+        l(Direction::TransmissionBack),
+    )
+}
+
+/// Reciprocity between the two transmission components given the Lambertian parts (sr⁻¹, CIE Y)
+/// split off XML `Transmission Front` (`front`) and `Transmission Back` (`back`). Radiance keeps
+/// one Lambertian transmission, the front's: `Transmission Back` enters with its own part
+/// replaced by the front's (found by experiment: offsets added to either block, or both).
+pub fn transmission_reciprocity_with(b: &Bsdf, front: f64, back: f64) -> Option<Reciprocity> {
     let f = b.klems(Direction::TransmissionFront, &Wavelength::Visible)?;
     let g = b.klems(Direction::TransmissionBack, &Wavelength::Visible)?;
-    reciprocity(f, g)
+    reciprocity_shifted(f, g, front - back)
 }
 
 /// The largest `T + R` over incident patches for light arriving on one side
@@ -266,6 +290,7 @@ pub fn tree_component(b: &Bsdf, d: Direction) -> Option<ComponentCheck> {
     };
     Some(ComponentCheck {
         lambertian_xyz: [y; 3],
+        lambertian_y: if min > LAMBERTIAN_MIN { min } else { 0.0 },
         max_total,
         min_angle_deg: (2.0 * cell).to_degrees(),
         normal_total,
