@@ -101,6 +101,98 @@ fn oracle_check_variants_identical() {
     }
 }
 
+/// Adds `xyz[k]` to the values of a block of direction `d` (k: CIE-X, Visible, CIE-Z); other
+/// blocks unchanged.
+fn offset(block: &str, d: &str, xyz: [f64; 3]) -> String {
+    if !block.contains(&format!(">{d}<")) {
+        return block.to_string();
+    }
+    for (k, w) in ["CIE-X", "Visible", "CIE-Z"].iter().enumerate() {
+        if block.contains(&format!(">{w}<")) {
+            return rescale(block, |v| v + xyz[k]);
+        }
+    }
+    block.to_string()
+}
+
+/// Lambertian parts (values offset so that the minimum exceeds 0.01/π), grey and coloured, on
+/// either transmission block or both, a file with one transmission block, a matrix with zeros,
+/// and two coloured files in one run (the colour dither goes on from file to file): Radiance's
+/// section identical to the oracle's. This covers the coloured split in Sharp RGB (Lambertian
+/// XYZ), the shared Lambertian transmission (a missing block's row; reciprocity with the back
+/// block's part replaced by the front's) and pairs with a zero element left out.
+#[test]
+fn oracle_check_lambertian_variants_identical() {
+    let Some(o) = common::oracle() else { return };
+    let dir = common::scratch("checkbsdf-lambertian");
+    let visible = |b: &str| b.contains(">Visible<");
+    let (tf, tb, rb) = ("Transmission Front", "Transmission Back", "Reflection Back");
+    let files = [
+        variant(&dir, "tfl.xml", |b| {
+            (visible(b) && b.contains(tf)).then(|| rescale(b, |v| v + 0.05))
+        }),
+        variant(&dir, "tbl.xml", |b| {
+            (visible(b) && b.contains(tb)).then(|| rescale(b, |v| v + 0.05))
+        }),
+        variant(&dir, "lambg2.xml", |b| {
+            visible(b).then(|| offset(b, tb, [0.04; 3]))
+        }),
+        variant(&dir, "lambg3.xml", |b| {
+            visible(b).then(|| offset(&offset(b, tf, [0.05; 3]), tb, [0.02; 3]))
+        }),
+        variant(&dir, "zeros.xml", |b| {
+            visible(b).then(|| {
+                if b.contains(rb) {
+                    rescale(b, |v| if v < 0.02 { 0.0 } else { v })
+                } else {
+                    b.to_string()
+                }
+            })
+        }),
+        variant(&dir, "lambc.xml", |b| {
+            Some(offset(
+                &offset(b, tf, [0.06, 0.05, 0.04]),
+                rb,
+                [0.02, 0.02, 0.03],
+            ))
+        }),
+        variant(&dir, "lambc2.xml", |b| {
+            Some(offset(b, tb, [0.03, 0.04, 0.05]))
+        }),
+        variant(&dir, "lambc3.xml", |b| {
+            Some(offset(
+                &offset(b, tf, [0.06, 0.05, 0.04]),
+                tb,
+                [0.03, 0.04, 0.05],
+            ))
+        }),
+    ];
+    let name = |f: &PathBuf| f.file_name().unwrap().to_owned();
+    let mut runs: Vec<Vec<std::ffi::OsString>> = files.iter().map(|f| vec![name(f)]).collect();
+    runs.push(vec![name(&files[5]), name(&files[6])]);
+    for run in &runs {
+        let mine = common::fenestra("checkBSDF")
+            .current_dir(&dir)
+            .args(run)
+            .output()
+            .unwrap();
+        assert!(mine.status.success(), "{run:?}");
+        // Radiance's part of each file's report.
+        let ours: String = String::from_utf8_lossy(&mine.stdout)
+            .split("=====================================================\n")
+            .filter(|r| !r.is_empty())
+            .map(|r| {
+                format!(
+                    "=====================================================\n{}",
+                    radiance_part(r.as_bytes())
+                )
+            })
+            .collect();
+        let theirs = common::run_ok(o.command("checkBSDF").current_dir(&dir).args(run));
+        assert_eq!(ours, String::from_utf8_lossy(&theirs), "{run:?}");
+    }
+}
+
 /// Our section: normal and diffuse totals, and a warning when T + R exceeds 1 + 1%.
 #[test]
 fn totals_and_energy_warning() {
