@@ -682,7 +682,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         return Ok(ExitCode::SUCCESS);
     }
     // -u: record by record, the output flushed after each
-    let mut buf: Vec<u8> = Vec::with_capacity(1 << 17);
+    let mut buf: Vec<u8> = Vec::new();
     let mut cols: Vec<f64> = Vec::new();
     for f in &files {
         let mut input = fenestra_cli::input::open(f)?;
@@ -705,13 +705,9 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                         ev.st.set_chans(&cols);
                         ev.record(&mut buf)?;
                         ev.print_warnings();
-                        if flush || buf.len() >= 1 << 16 {
-                            out.write_all(&buf)?;
-                            buf.clear();
-                            if flush {
-                                out.flush()?;
-                            }
-                        }
+                        out.write_all(&buf)?;
+                        buf.clear();
+                        out.flush()?;
                     }
                 }
                 Framing::Binary { n, size } => {
@@ -732,13 +728,9 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                         ev.st.set_chans(&cols);
                         ev.record(&mut buf)?;
                         ev.print_warnings();
-                        if flush || buf.len() >= 1 << 16 {
-                            out.write_all(&buf)?;
-                            buf.clear();
-                            if flush {
-                                out.flush()?;
-                            }
-                        }
+                        out.write_all(&buf)?;
+                        buf.clear();
+                        out.flush()?;
                     }
                 }
             }
