@@ -13,23 +13,34 @@
 /// Largest number of modifiers a ray can be blind to at once.
 pub const MAX_CLIP: usize = 8;
 
-/// A small set of modifiers (scene indices) with a crossing count each.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct ClipSet {
+/// A small set of modifiers (scene indices) with a crossing count each. Every ray carries
+/// one, almost always empty: the empty set is a null pointer, so rays stay small and copying
+/// one costs nothing outside antimatter.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ClipSet(Option<Box<Mods>>);
+
+#[derive(Debug, Clone, Default, PartialEq)]
+struct Mods {
     len: u8,
     mods: [(u32, i32); MAX_CLIP],
+}
+
+impl Mods {
+    fn find(&self, m: usize) -> Option<usize> {
+        self.mods[..self.len as usize]
+            .iter()
+            .position(|&(k, _)| k as usize == m)
+    }
 }
 
 impl ClipSet {
     /// True when the ray sees every surface.
     pub fn is_empty(&self) -> bool {
-        self.len == 0
+        self.0.is_none()
     }
 
     fn find(&self, m: usize) -> Option<usize> {
-        self.mods[..self.len as usize]
-            .iter()
-            .position(|&(k, _)| k as usize == m)
+        self.0.as_ref().and_then(|s| s.find(m))
     }
 
     /// Whether surfaces with direct modifier `m` are invisible.
@@ -39,36 +50,45 @@ impl ClipSet {
 
     /// Adds `m` (kept with its count if present); false when the set is full.
     pub fn insert(&mut self, m: usize) -> bool {
-        if self.contains(m) {
+        let s = self.0.get_or_insert_with(Default::default);
+        if s.find(m).is_some() {
             return true;
         }
-        if self.len as usize == MAX_CLIP {
+        if s.len as usize == MAX_CLIP {
             return false;
         }
-        self.mods[self.len as usize] = (m as u32, 0);
-        self.len += 1;
+        s.mods[s.len as usize] = (m as u32, 0);
+        s.len += 1;
         true
     }
 
     /// Removes `m` if present.
     pub fn remove(&mut self, m: usize) {
-        if let Some(i) = self.find(m) {
-            let n = self.len as usize;
-            self.mods.copy_within(i + 1..n, i);
-            self.len -= 1;
+        let Some(s) = self.0.as_mut() else { return };
+        if let Some(i) = s.find(m) {
+            let n = s.len as usize;
+            s.mods.copy_within(i + 1..n, i);
+            s.len -= 1;
+        }
+        if s.len == 0 {
+            self.0 = None;
         }
     }
 
     /// Records that the ray passed a surface of `m` through its front (`front`) or back.
     pub fn cross(&mut self, m: usize, front: bool) {
-        if let Some(i) = self.find(m) {
-            self.mods[i].1 += if front { 1 } else { -1 };
+        if let Some(s) = self.0.as_mut() {
+            if let Some(i) = s.find(m) {
+                s.mods[i].1 += if front { 1 } else { -1 };
+            }
         }
     }
 
     /// Whether the ray is inside a volume bounded by `m` surfaces it passed while blind.
     pub fn inside(&self, m: usize) -> bool {
-        self.find(m).is_some_and(|i| self.mods[i].1 > 0)
+        self.0
+            .as_ref()
+            .is_some_and(|s| s.find(m).is_some_and(|i| s.mods[i].1 > 0))
     }
 }
 
@@ -94,5 +114,9 @@ mod tests {
             assert!(c.insert(k));
         }
         assert!(!c.insert(99), "a full set refuses a ninth modifier");
+        for k in [3].into_iter().chain(10..17) {
+            c.remove(k);
+        }
+        assert!(c.is_empty() && c == ClipSet::default());
     }
 }

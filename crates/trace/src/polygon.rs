@@ -190,7 +190,7 @@ impl Polygon {
         if !(t > tmin && t < tmax) {
             return None;
         }
-        let p = rel + dir * t;
+        let p = (rel + dir * t).to_array();
         let q = DVec2::new(p[self.axes.0], p[self.axes.1]);
         self.contains(q).then_some(t)
     }

@@ -743,7 +743,7 @@ impl Tracer {
             src: if flag == TRANS { r.src } else { None },
             skip,
             start: r.start + dist,
-            clip: r.clip,
+            clip: r.clip.clone(),
         }
     }
 
@@ -1610,7 +1610,8 @@ impl Tracer {
             wt = d;
         }
         let n = (((self.opts.ad as f64 * wt).sqrt() + 0.5) as usize).max(1);
-        let acoef = rcol / (n * n) as f64;
+        // (n = 1, the common case below the first bounce: dividing by 1 is exact, so skipped)
+        let acoef = if n == 1 { rcol } else { rcol / (n * n) as f64 };
         let (a, b) = frame(nrm);
         let skip = shape.filter(|&s| self.accel.shapes[s].is_flat());
         let mut sum = DVec3::ZERO;
@@ -1624,8 +1625,12 @@ impl Tracer {
         while done < total {
             let m = (total - done).min(AMB_BATCH);
             for d in dirs.iter_mut().take(m) {
-                let x = (j as f64 + cx.rng.next_f64()) / nf;
-                let y = (i as f64 + cx.rng.next_f64()) / nf;
+                let (rx, ry) = (cx.rng.next_f64(), cx.rng.next_f64());
+                let (x, y) = if n == 1 {
+                    (rx, ry)
+                } else {
+                    ((j as f64 + rx) / nf, (i as f64 + ry) / nf)
+                };
                 j += 1;
                 if j == n {
                     j = 0;
