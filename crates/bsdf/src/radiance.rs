@@ -246,7 +246,8 @@ fn split_colour(
             min[ch] = min[ch].min(c[ch]);
         }
     }
-    if !(min.iter().sum::<f64>() > 0.01 / std::f64::consts::PI) {
+    let sum: f64 = min.iter().sum();
+    if sum.is_nan() || sum <= 0.01 / std::f64::consts::PI {
         return None;
     }
     let to_xyz = |c: [f64; 3]| mul3(&sharp_to_xyz, [c[0] / w[0], c[1] / w[1], c[2] / w[2]]);
