@@ -617,3 +617,25 @@ fn threads_give_the_output_of_one_thread() {
         assert_eq!(one.2, three.2, "{args:?}: messages differ");
     }
 }
+
+/// A read error (here a failing input command) stops rcalc after the records read
+/// before it, with the same output on one thread, several threads and with `-u`.
+#[test]
+fn read_error_after_the_records_before_it() {
+    for (threads, u) in [("1", false), ("3", false), ("1", true)] {
+        let mut args = vec!["-e", "$1=$1*2"];
+        if u {
+            args.push("-u");
+        }
+        args.push("!printf '1\\n2\\n3\\n'; exit 3");
+        let mut c = ours(&args);
+        c.env("FENESTRA_RCALC_THREADS", threads);
+        let (ok, out, err) = run_with(c, b"");
+        assert!(!ok, "threads {threads}, -u {u}: exit status");
+        assert_eq!(out, "2\n4\n6\n", "threads {threads}, -u {u}");
+        assert!(
+            err.contains("exit status: 3"),
+            "threads {threads}, -u {u}: {err}"
+        );
+    }
+}

@@ -428,12 +428,15 @@ fn binary_cols(r: &[u8], size: usize, cols: &mut Vec<f64>) {
 const BLOCK: usize = 1 << 18;
 
 /// Reads the next block of whole records (what is left of an incomplete one is kept
-/// in `carry`); an empty block at the end of the input.
+/// in `carry`), and whether it is the last; an empty block at the end of the input.
+/// A read error ends the input: the block read before it is returned as the last,
+/// with the error, to be reported after the block's records (as reading record by
+/// record would).
 fn next_block(
     input: &mut dyn Read,
     framing: Framing,
     carry: &mut Vec<u8>,
-) -> std::io::Result<(Vec<u8>, bool)> {
+) -> (Vec<u8>, bool, Option<std::io::Error>) {
     let mut block = Vec::with_capacity(BLOCK + carry.len() + 4096);
     block.append(carry);
     let want = BLOCK.max(block.len() + 4096);
@@ -445,7 +448,10 @@ fn next_block(
             match input.read(&mut block[at..]) {
                 Ok(k) => break k,
                 Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
-                Err(e) => return Err(e),
+                Err(e) => {
+                    block.truncate(at);
+                    return (block, true, Some(e));
+                }
             }
         };
         block.truncate(at + k);
@@ -462,7 +468,7 @@ fn next_block(
         carry.extend_from_slice(&block[cut..]);
         block.truncate(cut);
     }
-    Ok((block, eof))
+    (block, eof, None)
 }
 
 /// Evaluates one input with `threads` evaluators on blocks of records, output in
@@ -507,13 +513,21 @@ fn run_parallel<'c>(
             let mut carry = Vec::new();
             let mut i = 0usize;
             loop {
-                let b = next_block(&mut input, framing, &mut carry)
-                    .map_err(|e| format!("reading {fname}: {e}"));
-                let end = !matches!(b, Ok((_, false)));
-                if to_workers[i % to_workers.len()].send(b).is_err() || end {
+                let (block, last, err) = next_block(&mut input, framing, &mut carry);
+                if to_workers[i % to_workers.len()]
+                    .send(Ok((block, last)))
+                    .is_err()
+                {
                     break;
                 }
                 i += 1;
+                if let Some(e) = err {
+                    let _ =
+                        to_workers[i % to_workers.len()].send(Err(format!("reading {fname}: {e}")));
+                }
+                if last {
+                    break;
+                }
             }
         });
         let mut i = 0usize;
@@ -662,9 +676,11 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             let mut input = fenestra_cli::input::open(f)?;
             let mut carry = Vec::new();
             loop {
-                let (block, last) = next_block(&mut input, framing, &mut carry)
-                    .with_context(|| format!("reading {f}"))?;
-                let done = eval_block(&mut ev, framing, f, &block, last);
+                let (block, last, err) = next_block(&mut input, framing, &mut carry);
+                let mut done = eval_block(&mut ev, framing, f, &block, last);
+                if let (None, Some(e)) = (&done.err, err) {
+                    done.err = Some(anyhow::Error::new(e).context(format!("reading {f}")));
+                }
                 out.write_all(&done.out)?;
                 for m in done.warnings {
                     fenestra_cli::warn(m);
