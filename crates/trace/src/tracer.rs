@@ -1664,12 +1664,57 @@ fn square_to_disk(x: f64, y: f64) -> (f64, f64) {
     if a == 0.0 && b == 0.0 {
         return (0.0, 0.0);
     }
-    // one division and selects instead of branches (the branch is a coin toss)
+    // one division and selects instead of branches (the branch is a coin toss); the angle
+    // is q (|q| ≤ π/4) or π/2 − q, whose cosine and sine are q's sine and cosine
     let outer_a = a * a > b * b;
     let (r, num) = if outer_a { (a, b) } else { (b, a) };
     let q = (PI / 4.0) * (num / r);
-    let phi = if outer_a { q } else { PI / 2.0 - q };
-    (r * phi.cos(), r * phi.sin())
+    let (s, c) = sin_cos_quarter(q);
+    if outer_a {
+        (r * c, r * s)
+    } else {
+        (r * s, r * c)
+    }
+}
+
+/// Sine and cosine of |x| ≤ π/4 by their Taylor series to x¹⁷ and x¹⁸ (truncation below
+/// 1e-19; within 2 ulp of the correctly rounded values, checked in the tests): no call and
+/// no branch, unlike the library's general-argument routine.
+fn sin_cos_quarter(x: f64) -> (f64, f64) {
+    let x2 = x * x;
+    // 1/(2k+1)! and 1/(2k)!, highest order first
+    const S: [f64; 8] = [
+        1.0 / 355_687_428_096_000.0,
+        -1.0 / 1_307_674_368_000.0,
+        1.0 / 6_227_020_800.0,
+        -1.0 / 39_916_800.0,
+        1.0 / 362_880.0,
+        -1.0 / 5040.0,
+        1.0 / 120.0,
+        -1.0 / 6.0,
+    ];
+    const C: [f64; 9] = [
+        1.0 / 6_402_373_705_728_000.0,
+        -1.0 / 20_922_789_888_000.0,
+        1.0 / 87_178_291_200.0,
+        -1.0 / 479_001_600.0,
+        1.0 / 3_628_800.0,
+        -1.0 / 40_320.0,
+        1.0 / 720.0,
+        -1.0 / 24.0,
+        0.5,
+    ];
+    let mut ps = 0.0;
+    for k in S {
+        ps = ps * x2 + k;
+    }
+    let mut pc = 0.0;
+    for k in C {
+        pc = pc * x2 + k;
+    }
+    // sin = x + x·x²·P(x²); cos = 1 − x²·(1/2 − x²·Q(x²)) written as 1 − x²·pc with the
+    // signs folded into C
+    (x + x * x2 * ps, 1.0 - x2 * pc)
 }
 
 /// Two unit vectors completing `n` to an orthonormal frame.
@@ -1756,5 +1801,41 @@ impl Tracer {
             }
         }
         [0.0; 3]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quarter_sin_cos_within_two_ulp() {
+        let ulp = |v: f64| f64::EPSILON * v.abs().max(f64::MIN_POSITIVE);
+        let mut worst: f64 = 0.0;
+        for k in -100_000..=100_000 {
+            let x = (PI / 4.0) * k as f64 / 100_000.0;
+            let (s, c) = sin_cos_quarter(x);
+            let es = (s - x.sin()).abs() / ulp(x.sin());
+            let ec = (c - x.cos()).abs() / ulp(x.cos());
+            worst = worst.max(es).max(ec);
+        }
+        assert!(worst <= 2.0, "{worst} ulp");
+    }
+
+    #[test]
+    fn concentric_map_equals_its_library_trig_form() {
+        let mut rng = Rng::for_ray(1, 2);
+        for _ in 0..100_000 {
+            let (x, y) = (rng.next_f64(), rng.next_f64());
+            let (u, v) = square_to_disk(x, y);
+            let (a, b) = (2.0 * x - 1.0, 2.0 * y - 1.0);
+            let (r, phi) = if a * a > b * b {
+                (a, (PI / 4.0) * (b / a))
+            } else {
+                (b, PI / 2.0 - (PI / 4.0) * (a / b))
+            };
+            assert!((u - r * phi.cos()).abs() < 1e-15, "{x} {y}");
+            assert!((v - r * phi.sin()).abs() < 1e-15, "{x} {y}");
+        }
     }
 }
