@@ -363,12 +363,17 @@ fn eval_block(ev: &mut Eval, framing: Framing, fname: &str, block: &[u8], last: 
                 while at < block.len() {
                     let len = match sep {
                         None => {
-                            let len = ws_line(&block[at..], &mut cols)
+                            // parsed straight into the state's channels
+                            let chans = ev.st.chans_mut();
+                            let len = ws_line(&block[at..], chans)
                                 .with_context(|| format!("reading {fname}"))?;
                             if count > 0 {
-                                cols.truncate(count);
+                                chans.truncate(count);
                             }
-                            len
+                            ev.st.touch();
+                            at += len;
+                            ev.record(&mut out)?;
+                            continue;
                         }
                         Some(_) => {
                             let rest = &block[at..];
