@@ -222,7 +222,15 @@ fn plain_at(buf: &[u8], mut i: usize) -> Option<(f64, usize)> {
     let neg = c == b'-';
     i += usize::from(neg | (c == b'+'));
     let (mut m, mut nd, mut frac) = (0u64, 0u32, 0usize);
-    i = digit_run(buf, i, &mut m, &mut nd);
+    // the integer part is usually short: digit by digit
+    while i < n && buf[i].is_ascii_digit() && nd < 18 {
+        m = m * 10 + u64::from(buf[i] - b'0');
+        nd += 1;
+        i += 1;
+    }
+    if i < n && buf[i].is_ascii_digit() {
+        i = digit_run(buf, i, &mut m, &mut nd);
+    }
     if i < n && buf[i] == b'.' {
         let at = nd;
         i = digit_run(buf, i + 1, &mut m, &mut nd);
@@ -231,7 +239,8 @@ fn plain_at(buf: &[u8], mut i: usize) -> Option<(f64, usize)> {
     if nd == 0 || nd > 18 || (i < n && !is_ws(buf[i])) || m > 1 << 53 || frac >= POW10.len() {
         return None;
     }
-    let v = m as f64 / POW10[frac];
+    // (m <= 2^53: converted exactly, through i64 for a single instruction)
+    let v = (m as i64) as f64 / POW10[frac];
     Some((f64::from_bits(v.to_bits() | u64::from(neg) << 63), i))
 }
 
