@@ -46,9 +46,10 @@ pub fn push_g(out: &mut Vec<u8>, x: f64, prec: usize, scratch: &mut String) {
         1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
         1e17,
     ];
-    if x.fract() == 0.0 && x.abs() < POW10[p] {
-        // an integer of at most `p` digits prints as itself
-        let mut n = x.abs() as u64;
+    // an integer of at most `p` digits prints as itself (|x| < 1e17 < 2^63: `x as i64`
+    // is exact for integers, single instructions both ways)
+    if x.abs() < POW10[p] && (x as i64) as f64 == x {
+        let mut n = (x as i64).unsigned_abs();
         let mut d = [0u8; 20];
         let mut i = d.len();
         while n > 0 || i == d.len() {
