@@ -1604,16 +1604,41 @@ impl Tracer {
         if !self.effects.ambient || r.amb >= self.opts.ab {
             return rcol * DVec3::from_array(self.opts.av);
         }
-        let mut wt = r.weight;
-        let d = 0.8 * maxc(rcol) * r.weight / (self.opts.ad as f64 * self.opts.lw);
-        if wt > d {
-            wt = d;
-        }
-        let n = (((self.opts.ad as f64 * wt).sqrt() + 0.5) as usize).max(1);
-        // (n = 1, the common case below the first bounce: dividing by 1 is exact, so skipped)
-        let acoef = if n == 1 { rcol } else { rcol / (n * n) as f64 };
+        let ad = self.opts.ad as f64;
+        // n = round(sqrt(ad · min(weight, d))) ≥ 1; below ad · weight = 2.25 it is 1 whatever
+        // d is (the usual case past the first bounce), without the division and the root
+        let n = if ad * r.weight < 2.25 {
+            1
+        } else {
+            let mut wt = r.weight;
+            let d = 0.8 * maxc(rcol) * r.weight / (ad * self.opts.lw);
+            if wt > d {
+                wt = d;
+            }
+            (((ad * wt).sqrt() + 0.5) as usize).max(1)
+        };
         let (a, b) = frame(nrm);
         let skip = shape.filter(|&s| self.accel.shapes[s].is_flat());
+        let shoot = |dir: DVec3, acoef: DVec3, cx: &mut Ctx| {
+            let mut rc = acoef;
+            let mut c = self.child(r, p, dir, AMBIENT, rc, skip, 0.0);
+            c.amb = r.amb + 1;
+            if !self.admit(&mut c, &mut rc, cx) {
+                return DVec3::ZERO;
+            }
+            rc * self.trace(&c, cx)
+        };
+        let direction = |x: f64, y: f64| {
+            let (u, v) = square_to_disk(x, y);
+            let z = (1.0 - u * u - v * v).max(0.0).sqrt();
+            (a * u + b * v + nrm * z).normalize()
+        };
+        if n == 1 {
+            // one stratum: the unit square itself (no division by 1, no batch)
+            let (x, y) = (cx.rng.next_f64(), cx.rng.next_f64());
+            return shoot(direction(x, y), rcol, cx);
+        }
+        let acoef = rcol / (n * n) as f64;
         let mut sum = DVec3::ZERO;
         // Directions are drawn a batch at a time (stratum by stratum, row-major), then
         // traced: the batch's arithmetic runs without waiting on each ray's tracing.
@@ -1625,29 +1650,17 @@ impl Tracer {
         while done < total {
             let m = (total - done).min(AMB_BATCH);
             for d in dirs.iter_mut().take(m) {
-                let (rx, ry) = (cx.rng.next_f64(), cx.rng.next_f64());
-                let (x, y) = if n == 1 {
-                    (rx, ry)
-                } else {
-                    ((j as f64 + rx) / nf, (i as f64 + ry) / nf)
-                };
+                let x = (j as f64 + cx.rng.next_f64()) / nf;
+                let y = (i as f64 + cx.rng.next_f64()) / nf;
                 j += 1;
                 if j == n {
                     j = 0;
                     i += 1;
                 }
-                let (u, v) = square_to_disk(x, y);
-                let z = (1.0 - u * u - v * v).max(0.0).sqrt();
-                *d = (a * u + b * v + nrm * z).normalize();
+                *d = direction(x, y);
             }
             for &dir in &dirs[..m] {
-                let mut rc = acoef;
-                let mut c = self.child(r, p, dir, AMBIENT, rc, skip, 0.0);
-                c.amb = r.amb + 1;
-                if !self.admit(&mut c, &mut rc, cx) {
-                    continue;
-                }
-                sum += rc * self.trace(&c, cx);
+                sum += shoot(dir, acoef, cx);
             }
             done += m;
         }
