@@ -98,7 +98,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 "dt" => o.dt = num(&args, i + 1)?,
                 "dp" => {}
                 "aa" => aa = num(&args, i + 1)?,
-                "ar" | "as" | "aw" => {
+                "as" => o.asamp = num(&args, i + 1)?.max(0.0) as u32,
+                "ar" | "aw" => {
                     num(&args, i + 1)?;
                 }
                 "af" | "ai" | "ae" | "aI" | "aE" => {

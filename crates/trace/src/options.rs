@@ -29,6 +29,9 @@ pub struct TraceOptions {
     pub bv: bool,
     /// `-av`: ambient value beyond the last bounce.
     pub av: [f64; 3],
+    /// `-as`: ambient super-samples (extra hemisphere samples where strata vary most;
+    /// rtrace 512, rcontrib always 0 as Radiance's).
+    pub asamp: u32,
     /// Seed of the random streams (each input ray gets its own stream).
     pub seed: u64,
     /// Disable effect selection (run the full integrator; for tests and benchmarks).
@@ -61,7 +64,7 @@ impl CalSource {
 }
 
 impl TraceOptions {
-    /// rtrace's defaults (`-ab 0 -ad 1024 -lw 1e-4 -lr -10 -dt .03 -dj 0 -st .15`).
+    /// rtrace's defaults (`-ab 0 -ad 1024 -as 512 -lw 1e-4 -lr -10 -dt .03 -dj 0 -st .15`).
     pub fn rtrace() -> Self {
         TraceOptions {
             ab: 0,
@@ -77,13 +80,14 @@ impl TraceOptions {
             ss: 1.0,
             bv: true,
             av: [0.0; 3],
+            asamp: 512,
             seed: 0,
             full: false,
             cal: Vec::new(),
         }
     }
 
-    /// rcontrib's defaults (`-ab 1 -ad 350 -lw 2e-3 -dj .9 -dr 3 -st .02`, `-dt 0`).
+    /// rcontrib's defaults (`-ab 1 -ad 350 -lw 2e-3 -dj .9 -dr 3 -st .02`, `-dt 0`, `-as 0`).
     pub fn rcontrib() -> Self {
         TraceOptions {
             ab: 1,
@@ -93,6 +97,7 @@ impl TraceOptions {
             dr: 3,
             dt: 0.0,
             st: 0.02,
+            asamp: 0,
             ..Self::rtrace()
         }
     }
