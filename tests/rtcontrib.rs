@@ -1412,3 +1412,80 @@ fn oracle_limited_ray_distance() {
         }
     }
 }
+
+/// `-r` with `-c 0` adds this run's sums to those the files already hold (progressive
+/// runs), in every output format; a missing file is a warning and starts from zero; `-E`
+/// cannot be continued. Three runs of the same rays give three times one run's sums, and
+/// the files' data equal the oracle's byte for byte (same deterministic -ab 0 values).
+#[test]
+fn recover_with_c0_continues_the_sums() {
+    let dir = common::scratch("rtcontrib_r_c0");
+    let scene = dir.join("s.rad");
+    std::fs::write(
+        &scene,
+        "void glow sk 0 0 4 1 2 3 0\nsk source s 0 0 4 0 0 1 180\n\
+         void glow gr 0 0 4 .5 .5 .5 0\ngr source g 0 0 4 0 0 -1 180\n",
+    )
+    .unwrap();
+    let rays = b"0 0 0 0 0 1\n0 0 0 0 0 -1\n0 0 0 1 0 1\n";
+    let s = scene.display().to_string();
+    let run = |cmd: Command| {
+        let o = run_in(cmd, rays);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stderr).to_string()
+    };
+    let oracle = common::oracle();
+    let oct = oracle
+        .as_ref()
+        .map(|o| oracle_octree(o, &dir, std::slice::from_ref(&s)));
+    for fmt in ["a", "f", "d", "c"] {
+        let ff = format!("-fa{fmt}");
+        for k in 0..3 {
+            let mut c = rc(&["-r", "-c", "0", &ff, "-ab", "0", "-o", "p_%s.dat"]);
+            c.args(["-m", "sk", "-m", "gr", &s]).current_dir(&dir);
+            let err = run(c);
+            assert_eq!(
+                k == 0,
+                err.contains("missing reload file 'p_sk.dat'"),
+                "{err}"
+            );
+            if let (Some(o), Some(oct)) = (&oracle, &oct) {
+                let mut c = o.command("rcontrib");
+                c.args(["-r", "-c", "0", &ff, "-ab", "0", "-o", "q_%s.dat"]);
+                c.args(["-m", "sk", "-m", "gr", oct]).current_dir(&dir);
+                run(c);
+            }
+        }
+        for m in ["sk", "gr"] {
+            let ours = std::fs::read(dir.join(format!("p_{m}.dat"))).unwrap();
+            let read = common::fenestra("rmtxop")
+                .args(["-fa", &format!("p_{m}.dat")])
+                .current_dir(&dir)
+                .output()
+                .unwrap();
+            let v = nums(data_part(&read.stdout));
+            // two rays reach the sky, one the ground, in each run
+            let want = if m == "sk" { 6.0 } else { 3.0 };
+            if fmt == "c" {
+                // RGBE: 8-bit mantissas, decoded at the centre of their step (< 1/128)
+                assert!(v.len() == 3 && v.iter().all(|x| (x / want - 1.0).abs() < 1.0 / 128.0));
+            } else {
+                assert_eq!(v, vec![want; 3], "{fmt} {m}");
+            }
+            if oracle.is_some() {
+                let theirs = std::fs::read(dir.join(format!("q_{m}.dat"))).unwrap();
+                assert_eq!(data_part(&ours), data_part(&theirs), "{fmt} {m}");
+            }
+        }
+        for f in ["p_sk.dat", "p_gr.dat", "q_sk.dat", "q_gr.dat"] {
+            let _ = std::fs::remove_file(dir.join(f));
+        }
+    }
+    let mut c = rc(&[
+        "-r", "-c", "0", "-E", "-ab", "0", "-o", "p_%s.dat", "-Eo", "e_%s.dat",
+    ]);
+    c.args(["-m", "sk", &s]).current_dir(&dir);
+    let o = run_in(c, rays);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("-E with -r -c 0"));
+}

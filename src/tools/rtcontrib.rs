@@ -502,13 +502,27 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     if recover && overwrite {
         bail!("options -r and -fo are mutually exclusive");
     }
-    if recover && count == 0 {
-        bail!("-r with -c 0 (continuing a sum) is not supported by fenestra's rtcontrib");
+    // -r with -c 0: the sums earlier runs wrote are added to this run's (progressive runs)
+    let reload = recover && count == 0;
+    if reload && errors {
+        bail!("-E with -r -c 0: standard errors cannot be continued from the written sums");
+    }
+    let mut previous: Vec<Option<Vec<[f64; 3]>>> = Vec::new();
+    if reload {
+        for p in &plans {
+            let prev = output::reload_sums(p)?;
+            if prev.is_none() && warnings {
+                if let Some(n) = p.name.as_deref().filter(|n| !n.starts_with('!')) {
+                    fenestra_cli::warn(format!("missing reload file '{n}'"));
+                }
+            }
+            previous.push(prev);
+        }
     }
     // -r: what the interrupted run left (per stream), and the records all of them hold
     let mut parts: Vec<Option<output::Partial>> = Vec::new();
     let mut done_records = 0u64;
-    if recover {
+    if recover && !reload {
         for p in plans.iter().chain(&err_plans) {
             parts.push(output::examine_partial(p, fout)?);
         }
@@ -523,7 +537,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             .map(|p| p.map_or(0, |p| p.records))
             .min()
             .unwrap_or(0);
-    } else {
+    } else if !reload {
         output::check_files(&plans, overwrite)?;
         output::check_files(&err_plans, overwrite)?;
     }
@@ -602,7 +616,25 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             fenestra_cli::warn("dummy ray(s) ignored during accumulation");
         }
         let rec = engine.sum_all(&rays, &pool, &|n| progress.inc(n))?;
-        write(&rec, &mut streams, &mut err_streams)?;
+        if reload {
+            for (s, prev) in streams.iter_mut().zip(&previous) {
+                // write_record asks for the stream's items in order
+                let item = std::cell::Cell::new(0);
+                s.write_record(fout, rec.scale, |m, b| {
+                    let k = engine.slot(m, b) * 3;
+                    let mut v = [rec.sums[k], rec.sums[k + 1], rec.sums[k + 2]];
+                    if let Some(p) = prev {
+                        let i = item.replace(item.get() + 1);
+                        for (c, x) in v.iter_mut().enumerate() {
+                            *x += p[i][c] / rec.scale;
+                        }
+                    }
+                    v
+                })?;
+            }
+        } else {
+            write(&rec, &mut streams, &mut err_streams)?;
+        }
     } else {
         let nrec = rays.len().div_ceil(count);
         if rays.len() % count != 0 && warnings {

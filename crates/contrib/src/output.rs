@@ -474,6 +474,35 @@ pub struct Stream {
     txt: String,
 }
 
+/// `-r` with `-c 0`: the sums an earlier run wrote to this stream's file, one RGB triple per
+/// item, or `None` when there is no such file (a standard output or a command has none).
+/// Any format Radiance's matrices and pictures come in is read.
+pub fn reload_sums(plan: &StreamPlan) -> Result<Option<Vec<[f64; 3]>>> {
+    let Some(name) = &plan.name else {
+        return Ok(None);
+    };
+    if name.starts_with('!') || !std::path::Path::new(name).exists() {
+        return Ok(None);
+    }
+    let m = fenestra_formats::matrix::Matrix::read(name)
+        .with_context(|| format!("cannot reload the sums in '{name}'"))?;
+    let want = plan.items.len() * 3;
+    if m.ncomp != 3 || m.data.len() != want {
+        bail!(
+            "reload file '{name}': {} values in {} component(s), expected {want} (3 per bin of this run's {} bin(s))",
+            m.data.len(),
+            m.ncomp,
+            plan.items.len()
+        );
+    }
+    if let Some(v) = m.data.iter().find(|v| !v.is_finite()) {
+        bail!("reload file '{name}': the value {v} is not a number");
+    }
+    Ok(Some(
+        m.data.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+    ))
+}
+
 /// Checks that files can be created (no existing file unless `overwrite`).
 pub fn check_files(plans: &[StreamPlan], overwrite: bool) -> Result<()> {
     for p in plans {
