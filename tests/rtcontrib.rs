@@ -1489,3 +1489,85 @@ fn recover_with_c0_continues_the_sums() {
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("-E with -r -c 0"));
 }
+
+/// Crash safety for real: a binary run killed (SIGKILL) part-way leaves its partial file;
+/// `-r` completes it with the same bytes as an uninterrupted run.
+#[test]
+fn recover_after_killing_a_run() {
+    let dir = common::scratch("rtcontrib-kill");
+    // a grey roof under the sky: each ray reaching it spawns the -ad 64 ambient rays
+    let scene = dir.join("roofed.rad");
+    std::fs::write(
+        &scene,
+        "void glow skyglow 0 0 4 1 1 1 0\nskyglow source sky 0 0 4 0 0 1 180\n\
+         void glow groundglow 0 0 4 1 1 1 0\ngroundglow source ground 0 0 4 0 0 -1 180\n\
+         void plastic grey 0 0 5 .5 .5 .5 0 0\n\
+         grey polygon roof 0 0 12 -10 -10 5 10 -10 5 10 10 5 -10 10 5\n",
+    )
+    .unwrap();
+    let scene = scene.display().to_string();
+    let one = std::fs::read(fx("d_rays.dat")).unwrap();
+    // 200 rays repeated: 12 000 records of 10 rays, about 8 M rays traced
+    let rays: Vec<u8> = one.iter().copied().cycle().take(one.len() * 600).collect();
+    let input = dir.join("rays.txt");
+    std::fs::write(&input, &rays).unwrap();
+    let args = |out: &str, extra: &[&str]| -> Vec<String> {
+        let mut a: Vec<String> = ["-c", "10", "-ab", "1", "-ad", "64", "-fad"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        a.extend(extra.iter().map(|s| s.to_string()));
+        let o = dir.join(out).display().to_string();
+        for w in ["-o", &o, "-m", "skyglow", "-m", "groundglow", &scene] {
+            a.push(w.to_string());
+        }
+        a
+    };
+    let feed = |a: &[String]| {
+        let mut c = rc(&a.iter().map(String::as_str).collect::<Vec<_>>());
+        c.stdin(std::fs::File::open(&input).unwrap())
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped());
+        c
+    };
+    let full = feed(&args("full.dat", &[])).output().unwrap();
+    assert!(
+        full.status.success(),
+        "{}",
+        String::from_utf8_lossy(&full.stderr)
+    );
+    let full = std::fs::read(dir.join("full.dat")).unwrap();
+    let partial = dir.join(".part.dat.rtcontrib-partial");
+    let mut child = feed(&args("part.dat", &[])).spawn().unwrap();
+    // kill once some records (beyond the header) have reached the partial file
+    let start = std::time::Instant::now();
+    loop {
+        let len = std::fs::metadata(&partial).map(|m| m.len()).unwrap_or(0);
+        if len > 4096 {
+            break;
+        }
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the run ended before it could be killed; give it more work"
+        );
+        assert!(start.elapsed().as_secs() < 60, "no output after 60 s");
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    child.kill().unwrap();
+    assert!(!child.wait().unwrap().success());
+    assert!(partial.exists() && !dir.join("part.dat").exists());
+    let cut = std::fs::metadata(&partial).unwrap().len() as usize;
+    assert!(cut < full.len(), "killed after the last record");
+    eprintln!("killed with {cut} of {} bytes written", full.len());
+    let o = feed(&args("part.dat", &["-r"])).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // the header names the output file; the records must be the same bytes
+    let part = std::fs::read(dir.join("part.dat")).unwrap();
+    assert!(
+        cut > part.len() - data_part(&part).len(),
+        "killed within the header"
+    );
+    assert!(data_part(&part) == data_part(&full), "-r records differ");
+    assert!(!partial.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
