@@ -125,11 +125,8 @@ fn report(name: &str, b: &Bsdf, colour: &[(Direction, [f64; 3])]) -> Result<Stri
         comp(Direction::TransmissionFront),
     );
     s.push_str("Component\tLambertian XYZ (%)\tMax. Tot. Dir\tMin. Angle\n");
-    let row = |s: &mut String, label: &str, c: &Option<ComponentCheck>| {
-        let (l, m, a) = match c {
-            Some(c) => (c.lambertian_xyz, c.max_total, c.min_angle_deg),
-            None => ([0.0; 3], 0.0, 180.0),
-        };
+    // one component row: Lambertian XYZ, largest directional total, smallest angle
+    let line = |s: &mut String, label: &str, l: [f64; 3], m: f64, a: f64| {
         let _ = writeln!(
             s,
             "{label}\t{:4.1} {:4.1} {:4.1}\t\t{:5.1}%\t\t{} deg",
@@ -139,6 +136,10 @@ fn report(name: &str, b: &Bsdf, colour: &[(Direction, [f64; 3])]) -> Result<Stri
             100.0 * m,
             g(a, 3)
         );
+    };
+    let row = |s: &mut String, label: &str, c: &Option<ComponentCheck>| match c {
+        Some(c) => line(s, label, c.lambertian_xyz, c.max_total, c.min_angle_deg),
+        None => line(s, label, [0.0; 3], 0.0, 180.0),
     };
     row(&mut s, "Interior Refl", &rf);
     row(&mut s, "Exterior Refl", &rb);
@@ -152,17 +153,7 @@ fn report(name: &str, b: &Bsdf, colour: &[(Direction, [f64; 3])]) -> Result<Stri
     };
     let trow =
         |s: &mut String, label: &str, c: &Option<ComponentCheck>, other| match (c, shared(other)) {
-            (None, Some((l, m, a))) => {
-                let _ = writeln!(
-                    s,
-                    "{label}\t{:4.1} {:4.1} {:4.1}\t\t{:5.1}%\t\t{} deg",
-                    100.0 * l[0],
-                    100.0 * l[1],
-                    100.0 * l[2],
-                    100.0 * m,
-                    g(a, 3)
-                );
-            }
+            (None, Some((l, m, a))) => line(s, label, l, m, a),
             _ => row(s, label, c),
         };
     trow(&mut s, "Int->Ext Trans", &tf, &tb);

@@ -361,6 +361,19 @@ struct Done {
     err: Option<anyhow::Error>,
 }
 
+/// Writes a block's output and warnings; its error, if any, after flushing what came before.
+fn emit_block(out: &mut (impl Write + ?Sized), done: Done) -> Result<()> {
+    out.write_all(&done.out)?;
+    for m in done.warnings {
+        fenestra_cli::warn(m);
+    }
+    if let Some(e) = done.err {
+        out.flush()?;
+        return Err(e);
+    }
+    Ok(())
+}
+
 /// Evaluates the records of a block of whole records.
 fn eval_block(ev: &mut Eval, framing: Framing, fname: &str, block: &[u8], last: bool) -> Done {
     let mut out = Vec::with_capacity(block.len() / 2);
@@ -546,14 +559,7 @@ fn run_parallel<'c>(
         });
         let mut i = 0usize;
         while let Ok(done) = from_workers[i % threads].recv() {
-            out.write_all(&done.out)?;
-            for m in done.warnings {
-                fenestra_cli::warn(m);
-            }
-            if let Some(e) = done.err {
-                out.flush()?;
-                return Err(e);
-            }
+            emit_block(out, done)?;
             i += 1;
         }
         Ok(())
@@ -695,14 +701,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 if let (None, Some(e)) = (&done.err, err) {
                     done.err = Some(anyhow::Error::new(e).context(format!("reading {f}")));
                 }
-                out.write_all(&done.out)?;
-                for m in done.warnings {
-                    fenestra_cli::warn(m);
-                }
-                if let Some(e) = done.err {
-                    out.flush()?;
-                    return Err(e);
-                }
+                emit_block(&mut out, done)?;
                 if last {
                     break;
                 }
