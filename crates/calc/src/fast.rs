@@ -178,6 +178,51 @@ pub(crate) enum Op {
         n: u32,
     },
     Abort,
+    /// Made by the peephole pass: `d = a` and jump to `to`.
+    CopyJump {
+        d: u32,
+        a: u32,
+        to: u32,
+    },
+    /// `d = floor(a op b)` with the op's own semantics (`DivFloor` gives up on a zero
+    /// divisor like `Div`).
+    AddFloor {
+        d: u32,
+        a: u32,
+        b: u32,
+    },
+    SubFloor {
+        d: u32,
+        a: u32,
+        b: u32,
+    },
+    MulFloor {
+        d: u32,
+        a: u32,
+        b: u32,
+    },
+    DivFloor {
+        d: u32,
+        a: u32,
+        b: u32,
+    },
+    /// `d = k * asin(a)`, `k * acos(a)`, `k * atan2(y, x)`.
+    AsinMul {
+        d: u32,
+        a: u32,
+        k: u32,
+    },
+    AcosMul {
+        d: u32,
+        a: u32,
+        k: u32,
+    },
+    Atan2Mul {
+        d: u32,
+        y: u32,
+        x: u32,
+        k: u32,
+    },
 }
 
 /// The fast code of one root.
@@ -260,7 +305,15 @@ fn dst(op: &mut Op) -> Option<&mut u32> {
         | Op::Select { d, .. }
         | Op::SelectK { d, .. }
         | Op::Pick { d, .. }
-        | Op::PickGt { d, .. } => Some(d),
+        | Op::PickGt { d, .. }
+        | Op::CopyJump { d, .. }
+        | Op::AddFloor { d, .. }
+        | Op::SubFloor { d, .. }
+        | Op::MulFloor { d, .. }
+        | Op::DivFloor { d, .. }
+        | Op::AsinMul { d, .. }
+        | Op::AcosMul { d, .. }
+        | Op::Atan2Mul { d, .. } => Some(d),
         Op::JumpNotPos { .. } | Op::JumpNotGt { .. } | Op::Jump { .. } | Op::Abort => None,
     }
 }
@@ -831,7 +884,17 @@ pub(crate) fn build(c: &Compiled, root: &Node) -> Option<Fast> {
             }
             Op::JumpNotPos { c, .. } => *c = map(*c),
             // made by the peephole pass, after relocation
-            Op::JumpNotGt { .. } | Op::Pick { .. } | Op::PickGt { .. } => {}
+            Op::JumpNotGt { .. }
+            | Op::Pick { .. }
+            | Op::PickGt { .. }
+            | Op::CopyJump { .. }
+            | Op::AddFloor { .. }
+            | Op::SubFloor { .. }
+            | Op::MulFloor { .. }
+            | Op::DivFloor { .. }
+            | Op::AsinMul { .. }
+            | Op::AcosMul { .. }
+            | Op::Atan2Mul { .. } => {}
             Op::Select { d, i, .. } | Op::SelectK { d, i, .. } => {
                 *d = map(*d);
                 *i = map(*i);
@@ -877,6 +940,7 @@ pub(crate) fn build(c: &Compiled, root: &Node) -> Option<Fast> {
 fn reads(op: &Op, lists: &[u32], mut f: impl FnMut(u32)) {
     match *op {
         Op::Copy { a, .. }
+        | Op::CopyJump { a, .. }
         | Op::Neg { a, .. }
         | Op::Floor { a, .. }
         | Op::Asin { a, .. }
@@ -894,12 +958,23 @@ fn reads(op: &Op, lists: &[u32], mut f: impl FnMut(u32)) {
         | Op::Mul { a, b, .. }
         | Op::Div { a, b, .. }
         | Op::Pow { a, b, .. }
+        | Op::AddFloor { a, b, .. }
+        | Op::SubFloor { a, b, .. }
+        | Op::MulFloor { a, b, .. }
+        | Op::DivFloor { a, b, .. }
+        | Op::AsinMul { a, k: b, .. }
+        | Op::AcosMul { a, k: b, .. }
         | Op::Atan2 { y: a, x: b, .. }
         | Op::Jn { n: a, x: b, .. }
         | Op::Yn { n: a, x: b, .. }
         | Op::JumpNotGt { a, b, .. } => {
             f(a);
             f(b);
+        }
+        Op::Atan2Mul { y, x, k, .. } => {
+            f(y);
+            f(x);
+            f(k);
         }
         Op::Pick { c, x, y, .. } => {
             f(c);
@@ -924,7 +999,10 @@ fn reads(op: &Op, lists: &[u32], mut f: impl FnMut(u32)) {
 /// Calls `f` with each op index `op` may jump to (besides the next op).
 fn targets(op: &Op, lists: &[u32], mut f: impl FnMut(u32)) {
     match *op {
-        Op::JumpNotPos { to, .. } | Op::JumpNotGt { to, .. } | Op::Jump { to } => f(to),
+        Op::JumpNotPos { to, .. }
+        | Op::JumpNotGt { to, .. }
+        | Op::Jump { to }
+        | Op::CopyJump { to, .. } => f(to),
         Op::Select { l, n, .. } => {
             for &t in lists.get(l as usize..=(l + n) as usize).unwrap_or(&[]) {
                 f(t);
@@ -1039,7 +1117,51 @@ fn peephole(f: &mut Fast, nk: usize) {
         keep[j3] = false;
         landing[after] -= 1;
     }
-    // 3. the ops kept, jump targets renumbered
+    // 3. pairs of ops as one: a copy and the jump after it; `floor` of a sum,
+    // difference, product or quotient; a product with `asin`, `acos`, `atan2` (the
+    // intermediate value read by nothing else, the second op not a jump target)
+    for i in 0..n {
+        if !keep[i] {
+            continue;
+        }
+        let Some(j) = next(i, &keep) else { continue };
+        if landing[j] != 0 {
+            continue;
+        }
+        let once = |t: u32| uses.get(t as usize) == Some(&1);
+        let fused = match (f.ops[i], f.ops[j]) {
+            (Op::Copy { d, a }, Op::Jump { to }) => Some(Op::CopyJump { d, a, to }),
+            (Op::Add { d: t, a, b }, Op::Floor { d, a: u }) if t == u && once(t) => {
+                Some(Op::AddFloor { d, a, b })
+            }
+            (Op::Sub { d: t, a, b }, Op::Floor { d, a: u }) if t == u && once(t) => {
+                Some(Op::SubFloor { d, a, b })
+            }
+            (Op::Mul { d: t, a, b }, Op::Floor { d, a: u }) if t == u && once(t) => {
+                Some(Op::MulFloor { d, a, b })
+            }
+            (Op::Div { d: t, a, b }, Op::Floor { d, a: u }) if t == u && once(t) => {
+                Some(Op::DivFloor { d, a, b })
+            }
+            (Op::Asin { d: t, a }, Op::Mul { d, a: k, b: u }) if t == u && k != t && once(t) => {
+                Some(Op::AsinMul { d, a, k })
+            }
+            (Op::Acos { d: t, a }, Op::Mul { d, a: k, b: u }) if t == u && k != t && once(t) => {
+                Some(Op::AcosMul { d, a, k })
+            }
+            (Op::Atan2 { d: t, y, x }, Op::Mul { d, a: k, b: u })
+                if t == u && k != t && once(t) =>
+            {
+                Some(Op::Atan2Mul { d, y, x, k })
+            }
+            _ => None,
+        };
+        if let Some(op) = fused {
+            f.ops[i] = op;
+            keep[j] = false;
+        }
+    }
+    // 4. the ops kept, jump targets renumbered
     let mut newidx = vec![0u32; n + 1];
     let mut k = 0u32;
     for (i, x) in newidx.iter_mut().enumerate() {
@@ -1054,9 +1176,10 @@ fn peephole(f: &mut Fast, nk: usize) {
             continue;
         }
         match &mut op {
-            Op::JumpNotPos { to, .. } | Op::JumpNotGt { to, .. } | Op::Jump { to } => {
-                *to = newidx[*to as usize]
-            }
+            Op::JumpNotPos { to, .. }
+            | Op::JumpNotGt { to, .. }
+            | Op::Jump { to }
+            | Op::CopyJump { to, .. } => *to = newidx[*to as usize],
             Op::Select { l, n, .. } => {
                 for t in &mut f.lists[*l as usize..=(*l + *n) as usize] {
                     *t = newidx[*t as usize];
@@ -1066,7 +1189,7 @@ fn peephole(f: &mut Fast, nk: usize) {
         }
         f.ops.push(op);
     }
-    // 4. a jump to a jump goes straight to the latter's target
+    // 5. a jump to a jump goes straight to the latter's target
     let ops = f.ops.clone();
     let hop = |mut t: u32| {
         for _ in 0..8 {
@@ -1079,9 +1202,10 @@ fn peephole(f: &mut Fast, nk: usize) {
     };
     for op in &mut f.ops {
         match op {
-            Op::JumpNotPos { to, .. } | Op::JumpNotGt { to, .. } | Op::Jump { to } => {
-                *to = hop(*to)
-            }
+            Op::JumpNotPos { to, .. }
+            | Op::JumpNotGt { to, .. }
+            | Op::Jump { to }
+            | Op::CopyJump { to, .. } => *to = hop(*to),
             _ => {}
         }
     }
@@ -1270,6 +1394,31 @@ impl Fast {
                     }
                 }
                 Op::Abort => return None,
+                Op::CopyJump { d, a, to } => {
+                    r[d as usize] = r[a as usize];
+                    pc = to as usize;
+                }
+                Op::AddFloor { d, a, b } => {
+                    r[d as usize] = floor0(r[a as usize] + r[b as usize] + 0.0)
+                }
+                Op::SubFloor { d, a, b } => r[d as usize] = floor0(r[a as usize] - r[b as usize]),
+                Op::MulFloor { d, a, b } => r[d as usize] = floor0(r[a as usize] * r[b as usize]),
+                Op::DivFloor { d, a, b } => {
+                    let y = r[b as usize];
+                    if y == 0.0 {
+                        return None;
+                    }
+                    r[d as usize] = floor0(r[a as usize] / y);
+                }
+                Op::AsinMul { d, a, k } => {
+                    r[d as usize] = r[k as usize] * Math1::Asin.apply(r[a as usize])
+                }
+                Op::AcosMul { d, a, k } => {
+                    r[d as usize] = r[k as usize] * Math1::Acos.apply(r[a as usize])
+                }
+                Op::Atan2Mul { d, y, x, k } => {
+                    r[d as usize] = r[k as usize] * r[y as usize].atan2(r[x as usize])
+                }
             }
         }
         Some(r[self.out as usize])
@@ -1278,6 +1427,7 @@ impl Fast {
 
 #[cfg(test)]
 mod tests {
+    use super::Op;
     use crate::{Compiled, Program};
 
     /// A small deterministic generator (64-bit LCG); `.1` says which of `f1`, `f2`
@@ -1317,7 +1467,7 @@ mod tests {
                 8 => format!("max({}, {}, {})", e(self), e(self), e(self)),
                 9 => format!("min({}, {})", e(self), e(self)),
                 10 => format!("floor({})", e(self)),
-                11 => format!("sqrt({})", e(self)),
+                11 => format!("{}({})", ["sqrt", "acos"][self.next(2)], e(self)),
                 12 => format!("asin({})", e(self)),
                 13 => format!("atan2({}, {})", e(self), e(self)),
                 14 if self.1 & 1 != 0 => format!("f1({})", e(self)),
@@ -1388,6 +1538,67 @@ mod tests {
 
     /// Random programs evaluated with and without fast code: the same values, errors
     /// and warnings on every record.
+    #[test]
+    fn fused_pairs_agree_on_special_values() {
+        let src = "$1 = floor($1 + $2); $2 = floor($1 - $2); $3 = floor($1 * $2);\n\
+                   $4 = floor($1 / $2); $5 = 3*asin($1); $6 = $2*acos($1);\n\
+                   $7 = -2*atan2($1, $2); $8 = if($1, 1, $2*$2) + 1;";
+        let mut p = Program::for_rcalc();
+        p.load_str("-e", src).unwrap();
+        let fast = p.compile().unwrap();
+        let mut exact = fast.clone();
+        exact.fast.clear();
+        let special = [
+            f64::NAN,
+            -f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            0.0,
+            -0.0,
+            0.5,
+            -1.0,
+            2.5,
+            -3.75,
+            5e-324,
+            -5e-324,
+            4.5e15,
+            -4.5e15,
+            1e308,
+            -1e308,
+        ];
+        let (mut sf, mut se) = (fast.state(), exact.state());
+        for &a in &special {
+            for &b in &special {
+                let r = [a, b, 0.25];
+                assert_eq!(
+                    outcome(&fast, &mut sf, &r),
+                    outcome(&exact, &mut se, &r),
+                    "{r:?}"
+                );
+            }
+        }
+        // every fused pair was made, and the fast code ran (a zero divisor gives up)
+        let mut seen = [false; 8];
+        for f in fast.fast.iter().filter_map(|f| f.get()).flatten() {
+            for op in &f.ops {
+                let k = match op {
+                    Op::AddFloor { .. } => 0,
+                    Op::SubFloor { .. } => 1,
+                    Op::MulFloor { .. } => 2,
+                    Op::DivFloor { .. } => 3,
+                    Op::AsinMul { .. } => 4,
+                    Op::AcosMul { .. } => 5,
+                    Op::Atan2Mul { .. } => 6,
+                    Op::CopyJump { .. } => 7,
+                    _ => continue,
+                };
+                seen[k] = true;
+            }
+        }
+        assert_eq!(seen, [true; 8]);
+        assert!(sf.fast_hits > (special.len() * special.len() * 7) as u64);
+    }
+
     #[test]
     fn fast_code_agrees_with_the_exact_evaluator() {
         let mut g = Gen(12345, 3);
