@@ -10,6 +10,8 @@
 //! reflection and `f'` = the opposite transmission block; min, mean and max are over all element
 //! pairs without a zero element.
 
+pub mod tree;
+
 use crate::klems::KlemsBasis;
 use crate::model::{Bsdf, Direction, KlemsMatrix, Wavelength};
 

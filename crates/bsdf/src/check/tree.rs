@@ -1,0 +1,119 @@
+//! Reciprocity error of tensor-tree components, as reported by `checkBSDF`, computed on the
+//! tree's finest grid (deterministic; Radiance samples at random, see docs/tools/checkBSDF.md).
+//!
+//! Each pair compares the forward component's value `f(i → o)` with the reverse component's
+//! `g(o → i)`, both totals (Lambertian part included). Rank 4: cell centres of the finest grid
+//! for the incident and for the outgoing square, every pair once, so the tree position
+//! `(a, b)` (incident, outgoing) meets `g` at `(1 − b, 1 − a)` (the square ↔ disk map turns
+//! a direction's negation into `1 − x`). Rank 3: incident and outgoing directions from the
+//! finest grid of the square mapped to the disk, evaluated through [`TensorTree::eval`].
+
+use crate::check::Reciprocity;
+use crate::model::{BlockData, Bsdf, Direction, Wavelength};
+use crate::tree::{square_to_disk, TensorTree};
+
+/// The `Visible` tree of a component (`None` when absent or not a tree).
+fn tree(b: &Bsdf, d: Direction) -> Option<&TensorTree> {
+    match &b.block(d, &Wavelength::Visible)?.data {
+        BlockData::Tree(t) => Some(t),
+        BlockData::Klems(_) => None,
+    }
+}
+
+/// Accumulates pair errors (pairs with a zero element are left out, as for Klems matrices).
+#[derive(Default)]
+struct Stats {
+    lo: f64,
+    hi: f64,
+    sum: f64,
+    count: usize,
+}
+
+impl Stats {
+    fn new() -> Self {
+        Stats {
+            lo: f64::INFINITY,
+            ..Default::default()
+        }
+    }
+
+    fn add(&mut self, a: f64, b: f64) {
+        if a == 0.0 || b == 0.0 {
+            return;
+        }
+        let e = (a - b).abs() / a.max(b);
+        self.lo = self.lo.min(e);
+        self.hi = self.hi.max(e);
+        self.sum += e;
+        self.count += 1;
+    }
+
+    fn done(self) -> Reciprocity {
+        Reciprocity {
+            min: if self.lo.is_finite() { self.lo } else { 0.0 },
+            mean: self.sum / self.count.max(1) as f64,
+            max: self.hi,
+        }
+    }
+}
+
+/// Unit vector (z ≥ 0) of a square position through the Shirley–Chiu map.
+fn vector(u: f64, v: f64) -> [f64; 3] {
+    let (x, y) = square_to_disk(u, v);
+    [x, y, (1.0 - x * x - y * y).max(0.0).sqrt()]
+}
+
+/// Reciprocity of `f` against `g` (`shift` added to every value of `g`) on the finer of the
+/// two trees' finest grids; `None` when the ranks differ.
+pub fn tree_reciprocity(f: &TensorTree, g: &TensorTree, shift: f64) -> Option<Reciprocity> {
+    if f.rank() != g.rank() {
+        return None;
+    }
+    let cell = f.finest_cell().min(g.finest_cell());
+    let n = (1.0 / cell).round().max(1.0) as usize;
+    let c = |k: usize| (k as f64 + 0.5) / n as f64;
+    let mut st = Stats::new();
+    if f.rank() == 4 {
+        for i0 in 0..n {
+            for i1 in 0..n {
+                for o0 in 0..n {
+                    for o1 in 0..n {
+                        let a = f.lookup(&[c(i0), c(i1), c(o0), c(o1)]);
+                        let b = g.lookup(&[1.0 - c(o0), 1.0 - c(o1), 1.0 - c(i0), 1.0 - c(i1)]);
+                        st.add(a, b + shift);
+                    }
+                }
+            }
+        }
+    } else {
+        let dirs: Vec<[f64; 3]> = (0..n * n).map(|k| vector(c(k / n), c(k % n))).collect();
+        for i in &dirs {
+            for o in &dirs {
+                st.add(f.eval(*i, *o), g.eval(*o, *i) + shift);
+            }
+        }
+    }
+    Some(st.done())
+}
+
+/// Reciprocity of a reflection tree with itself (`None` without that tree).
+pub fn tree_reflection_reciprocity(b: &Bsdf, d: Direction) -> Option<Reciprocity> {
+    let t = tree(b, d)?;
+    tree_reciprocity(t, t, 0.0)
+}
+
+/// Reciprocity between the two transmission trees (`None` unless both exist): XML
+/// `Transmission Back` against `Transmission Front`, the front's Lambertian part replacing the
+/// back's (Radiance keeps one Lambertian transmission, the front's, as for Klems files).
+pub fn tree_transmission_reciprocity(b: &Bsdf) -> Option<Reciprocity> {
+    let back = tree(b, Direction::TransmissionBack)?;
+    let front = tree(b, Direction::TransmissionFront)?;
+    let l = |d| crate::check::tree_component(b, d).map_or(0.0, |c| c.lambertian_y);
+    // On the full grid every pair meets its reverse once, so which tree is "forward" does not
+    // change the figures.
+    tree_reciprocity(
+        front,
+        back,
+        l(Direction::TransmissionFront) - l(Direction::TransmissionBack),
+    )
+}
