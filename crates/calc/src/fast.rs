@@ -223,6 +223,32 @@ pub(crate) enum Op {
         x: u32,
         k: u32,
     },
+    /// `d = x + a*b`, `d = a*b + x`, `d = x - a*b` (two roundings, as the pair).
+    AddMul {
+        d: u32,
+        x: u32,
+        a: u32,
+        b: u32,
+    },
+    MulAdd {
+        d: u32,
+        a: u32,
+        b: u32,
+        x: u32,
+    },
+    SubMul {
+        d: u32,
+        x: u32,
+        a: u32,
+        b: u32,
+    },
+    /// `d = (a + b) + c`.
+    AddAdd {
+        d: u32,
+        a: u32,
+        b: u32,
+        c: u32,
+    },
 }
 
 /// The fast code of one root.
@@ -313,7 +339,11 @@ fn dst(op: &mut Op) -> Option<&mut u32> {
         | Op::DivFloor { d, .. }
         | Op::AsinMul { d, .. }
         | Op::AcosMul { d, .. }
-        | Op::Atan2Mul { d, .. } => Some(d),
+        | Op::Atan2Mul { d, .. }
+        | Op::AddMul { d, .. }
+        | Op::MulAdd { d, .. }
+        | Op::SubMul { d, .. }
+        | Op::AddAdd { d, .. } => Some(d),
         Op::JumpNotPos { .. } | Op::JumpNotGt { .. } | Op::Jump { .. } | Op::Abort => None,
     }
 }
@@ -894,7 +924,11 @@ pub(crate) fn build(c: &Compiled, root: &Node) -> Option<Fast> {
             | Op::DivFloor { .. }
             | Op::AsinMul { .. }
             | Op::AcosMul { .. }
-            | Op::Atan2Mul { .. } => {}
+            | Op::Atan2Mul { .. }
+            | Op::AddMul { .. }
+            | Op::MulAdd { .. }
+            | Op::SubMul { .. }
+            | Op::AddAdd { .. } => {}
             Op::Select { d, i, .. } | Op::SelectK { d, i, .. } => {
                 *d = map(*d);
                 *i = map(*i);
@@ -971,10 +1005,20 @@ fn reads(op: &Op, lists: &[u32], mut f: impl FnMut(u32)) {
             f(a);
             f(b);
         }
-        Op::Atan2Mul { y, x, k, .. } => {
-            f(y);
-            f(x);
-            f(k);
+        Op::Atan2Mul {
+            y: a, x: b, k: c, ..
+        }
+        | Op::AddMul {
+            x: a, a: b, b: c, ..
+        }
+        | Op::MulAdd { a, b, x: c, .. }
+        | Op::SubMul {
+            x: a, a: b, b: c, ..
+        }
+        | Op::AddAdd { a, b, c, .. } => {
+            f(a);
+            f(b);
+            f(c);
         }
         Op::Pick { c, x, y, .. } => {
             f(c);
@@ -1153,6 +1197,18 @@ fn peephole(f: &mut Fast, nk: usize) {
                 if t == u && k != t && once(t) =>
             {
                 Some(Op::Atan2Mul { d, y, x, k })
+            }
+            (Op::Mul { d: t, a, b }, Op::Add { d, a: x, b: u }) if t == u && x != t && once(t) => {
+                Some(Op::AddMul { d, x, a, b })
+            }
+            (Op::Mul { d: t, a, b }, Op::Add { d, a: u, b: x }) if t == u && x != t && once(t) => {
+                Some(Op::MulAdd { d, a, b, x })
+            }
+            (Op::Mul { d: t, a, b }, Op::Sub { d, a: x, b: u }) if t == u && x != t && once(t) => {
+                Some(Op::SubMul { d, x, a, b })
+            }
+            (Op::Add { d: t, a, b }, Op::Add { d, a: u, b: c }) if t == u && c != t && once(t) => {
+                Some(Op::AddAdd { d, a, b, c })
             }
             _ => None,
         };
@@ -1419,6 +1475,18 @@ impl Fast {
                 Op::Atan2Mul { d, y, x, k } => {
                     r[d as usize] = r[k as usize] * r[y as usize].atan2(r[x as usize])
                 }
+                Op::AddMul { d, x, a, b } => {
+                    r[d as usize] = r[x as usize] + r[a as usize] * r[b as usize] + 0.0
+                }
+                Op::MulAdd { d, a, b, x } => {
+                    r[d as usize] = r[a as usize] * r[b as usize] + r[x as usize] + 0.0
+                }
+                Op::SubMul { d, x, a, b } => {
+                    r[d as usize] = r[x as usize] - r[a as usize] * r[b as usize]
+                }
+                Op::AddAdd { d, a, b, c } => {
+                    r[d as usize] = (r[a as usize] + r[b as usize] + 0.0) + r[c as usize] + 0.0
+                }
             }
         }
         Some(r[self.out as usize])
@@ -1542,7 +1610,8 @@ mod tests {
     fn fused_pairs_agree_on_special_values() {
         let src = "$1 = floor($1 + $2); $2 = floor($1 - $2); $3 = floor($1 * $2);\n\
                    $4 = floor($1 / $2); $5 = 3*asin($1); $6 = $2*acos($1);\n\
-                   $7 = -2*atan2($1, $2); $8 = if($1, 1, $2*$2) + 1;";
+                   $7 = -2*atan2($1, $2); $8 = if($1, 1, $2*$2) + 1;\n\
+                   $9 = $1 + $2*3; $10 = $1*$2 + 3; $11 = 2 - $1*$2; $12 = ($1 + $2) + -0;";
         let mut p = Program::for_rcalc();
         p.load_str("-e", src).unwrap();
         let fast = p.compile().unwrap();
@@ -1578,7 +1647,7 @@ mod tests {
             }
         }
         // every fused pair was made, and the fast code ran (a zero divisor gives up)
-        let mut seen = [false; 8];
+        let mut seen = [false; 12];
         for f in fast.fast.iter().filter_map(|f| f.get()).flatten() {
             for op in &f.ops {
                 let k = match op {
@@ -1590,12 +1659,16 @@ mod tests {
                     Op::AcosMul { .. } => 5,
                     Op::Atan2Mul { .. } => 6,
                     Op::CopyJump { .. } => 7,
+                    Op::AddMul { .. } => 8,
+                    Op::MulAdd { .. } => 9,
+                    Op::SubMul { .. } => 10,
+                    Op::AddAdd { .. } => 11,
                     _ => continue,
                 };
                 seen[k] = true;
             }
         }
-        assert_eq!(seen, [true; 8]);
+        assert_eq!(seen, [true; 12]);
         assert!(sf.fast_hits > (special.len() * special.len() * 7) as u64);
     }
 
