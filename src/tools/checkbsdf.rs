@@ -83,6 +83,15 @@ fn data_type(b: &Bsdf) -> String {
     }
 }
 
+/// An angle as Radiance prints it: two decimals (`57.30`), `180` for an absent component.
+fn angle(a: f64) -> String {
+    if a >= 180.0 {
+        "180".into()
+    } else {
+        format!("{a:.2}")
+    }
+}
+
 /// The report for one file (`colour`: the coloured Lambertian parts split off on loading).
 fn report(name: &str, b: &Bsdf, colour: &[(Direction, [f64; 3])]) -> Result<String> {
     let mut s = String::new();
@@ -134,7 +143,7 @@ fn report(name: &str, b: &Bsdf, colour: &[(Direction, [f64; 3])]) -> Result<Stri
             100.0 * l[1],
             100.0 * l[2],
             100.0 * m,
-            g(a, 3)
+            angle(a)
         );
     };
     let row = |s: &mut String, label: &str, c: &Option<ComponentCheck>| match c {

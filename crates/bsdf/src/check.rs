@@ -18,6 +18,11 @@ use crate::model::{Bsdf, Direction, KlemsMatrix, Wavelength};
 /// Radiance's threshold for splitting a matrix minimum off as a Lambertian part (sr⁻¹).
 pub const LAMBERTIAN_MIN: f64 = 0.01 / std::f64::consts::PI;
 
+/// For tensor trees Radiance splits the minimum off only below this value (sr⁻¹): π·min must
+/// stay under 1.5 (found with the oracle on 2×2×2×2 trees: minimum 0.4774 split off as 150.0%,
+/// 0.4775 and above nothing; Klems matrices have no such limit: 154.5% split off).
+pub const TREE_LAMBERTIAN_MAX: f64 = 1.5 / std::f64::consts::PI;
+
 /// Summary of one component (one XML direction).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ComponentCheck {
@@ -212,7 +217,8 @@ pub fn energy_balance(b: &Bsdf, exterior: bool) -> Option<(f64, usize)> {
 }
 
 /// Summarises the `Visible` tensor tree of `d` (`None` when absent or not a tree): the
-/// Lambertian part is π × the smallest value (when above [`LAMBERTIAN_MIN`]); totals integrate
+/// Lambertian part is π × the smallest value (when between [`LAMBERTIAN_MIN`] and
+/// [`TREE_LAMBERTIAN_MAX`]); totals integrate
 /// the tree exactly on its finest grid (the square ↔ disk map preserves projected solid
 /// angle: a cell of area `a` covers `π·a`); the angle is `2 × the finest cell size` radians.
 pub fn tree_component(b: &Bsdf, d: Direction) -> Option<ComponentCheck> {
@@ -239,7 +245,9 @@ pub fn tree_component(b: &Bsdf, d: Direction) -> Option<ComponentCheck> {
     } else {
         t.min_value()
     };
-    let y = if min > LAMBERTIAN_MIN {
+    // Radiance splits nothing off a tree whose minimum reaches TREE_LAMBERTIAN_MAX.
+    let split = min > LAMBERTIAN_MIN && min < TREE_LAMBERTIAN_MAX;
+    let y = if split {
         std::f64::consts::PI * min
     } else {
         0.0
@@ -292,7 +300,7 @@ pub fn tree_component(b: &Bsdf, d: Direction) -> Option<ComponentCheck> {
     };
     Some(ComponentCheck {
         lambertian_xyz: [y; 3],
-        lambertian_y: if min > LAMBERTIAN_MIN { min } else { 0.0 },
+        lambertian_y: if split { min } else { 0.0 },
         max_total,
         min_angle_deg: (2.0 * cell).to_degrees(),
         normal_total,

@@ -63,9 +63,9 @@ fn vector(u: f64, v: f64) -> [f64; 3] {
     [x, y, (1.0 - x * x - y * y).max(0.0).sqrt()]
 }
 
-/// Reciprocity of `f` against `g` (`shift` added to every value of `g`) on the finer of the
+/// Reciprocity of `f` against `g` (`f(i → o)` vs `g(o → i)`) on the finer of the
 /// two trees' finest grids; `None` when the ranks differ.
-pub fn tree_reciprocity(f: &TensorTree, g: &TensorTree, shift: f64) -> Option<Reciprocity> {
+pub fn tree_reciprocity(f: &TensorTree, g: &TensorTree) -> Option<Reciprocity> {
     if f.rank() != g.rank() {
         return None;
     }
@@ -80,7 +80,7 @@ pub fn tree_reciprocity(f: &TensorTree, g: &TensorTree, shift: f64) -> Option<Re
                     for o1 in 0..n {
                         let a = f.lookup(&[c(i0), c(i1), c(o0), c(o1)]);
                         let b = g.lookup(&[1.0 - c(o0), 1.0 - c(o1), 1.0 - c(i0), 1.0 - c(i1)]);
-                        st.add(a, b + shift);
+                        st.add(a, b);
                     }
                 }
             }
@@ -89,7 +89,7 @@ pub fn tree_reciprocity(f: &TensorTree, g: &TensorTree, shift: f64) -> Option<Re
         let dirs: Vec<[f64; 3]> = (0..n * n).map(|k| vector(c(k / n), c(k % n))).collect();
         for i in &dirs {
             for o in &dirs {
-                st.add(f.eval(*i, *o), g.eval(*o, *i) + shift);
+                st.add(f.eval(*i, *o), g.eval(*o, *i));
             }
         }
     }
@@ -99,21 +99,17 @@ pub fn tree_reciprocity(f: &TensorTree, g: &TensorTree, shift: f64) -> Option<Re
 /// Reciprocity of a reflection tree with itself (`None` without that tree).
 pub fn tree_reflection_reciprocity(b: &Bsdf, d: Direction) -> Option<Reciprocity> {
     let t = tree(b, d)?;
-    tree_reciprocity(t, t, 0.0)
+    tree_reciprocity(t, t)
 }
 
 /// Reciprocity between the two transmission trees (`None` unless both exist): XML
-/// `Transmission Back` against `Transmission Front`, the front's Lambertian part replacing the
-/// back's (Radiance keeps one Lambertian transmission, the front's, as for Klems files).
+/// `Transmission Front` against `Transmission Back`, raw tree values. Unlike Klems files, no
+/// Lambertian part is exchanged (found with the oracle: front minimum 0.2, back 0.3 on 2×2×2×2
+/// trees gives Radiance's minimum error 33.3% = |0.2 − 0.3| / 0.3).
 pub fn tree_transmission_reciprocity(b: &Bsdf) -> Option<Reciprocity> {
     let back = tree(b, Direction::TransmissionBack)?;
     let front = tree(b, Direction::TransmissionFront)?;
-    let l = |d| crate::check::tree_component(b, d).map_or(0.0, |c| c.lambertian_y);
     // On the full grid every pair meets its reverse once, so which tree is "forward" does not
     // change the figures.
-    tree_reciprocity(
-        front,
-        back,
-        l(Direction::TransmissionFront) - l(Direction::TransmissionBack),
-    )
+    tree_reciprocity(front, back)
 }
