@@ -113,3 +113,40 @@ pub fn tree_transmission_reciprocity(b: &Bsdf) -> Option<Reciprocity> {
     // change the figures.
     tree_reciprocity(front, back)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 2×2×2×2 grid tree (one node of 16 values, dimension 0 slowest).
+    fn grid(v: impl Fn(usize) -> f64) -> TensorTree {
+        let vals: Vec<String> = (0..16).map(|k| v(k).to_string()).collect();
+        TensorTree::parse(4, &format!("{{ {} }}", vals.join(" "))).unwrap()
+    }
+
+    #[test]
+    fn one_raised_cell() {
+        // Cell (1,1,1,1) = 2 meets its reverse (0,0,0,0) = 1 and vice versa: 2 of 16 pairs
+        // with error 0.5, the rest 0.
+        let t = grid(|k| if k == 15 { 2.0 } else { 1.0 });
+        let r = tree_reciprocity(&t, &t).unwrap();
+        assert_eq!((r.min, r.max), (0.0, 0.5));
+        assert!((r.mean - 2.0 / 16.0 * 0.5).abs() < 1e-15, "{}", r.mean);
+        // Cell (1,0,0,1) (index 9) is its own reverse: no error.
+        let t = grid(|k| if k == 9 { 2.0 } else { 1.0 });
+        let r = tree_reciprocity(&t, &t).unwrap();
+        assert_eq!((r.min, r.mean, r.max), (0.0, 0.0, 0.0));
+    }
+
+    #[test]
+    fn transmission_pair_and_zeros() {
+        // front(x) = 1, back = 3 everywhere: every pair 2/3; zeros are left out.
+        let f = grid(|_| 1.0);
+        let b = grid(|k| if k == 0 { 0.0 } else { 3.0 });
+        let r = tree_reciprocity(&f, &b).unwrap();
+        assert!((r.min - 2.0 / 3.0).abs() < 1e-15 && (r.max - 2.0 / 3.0).abs() < 1e-15);
+        assert!((r.mean - 2.0 / 3.0).abs() < 1e-15);
+        let r3 = TensorTree::parse(3, "{ 1 1 1 1 1 1 1 1 }").unwrap();
+        assert!(tree_reciprocity(&f, &r3).is_none());
+    }
+}
