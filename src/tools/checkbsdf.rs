@@ -26,6 +26,10 @@ fn spec() -> Spec {
 /// Monte Carlo BSDFs (genBSDF) carry noise of this order.
 const ENERGY_NOISE: f64 = 0.01;
 
+/// Tree reciprocity rows: largest spread of pair errors (a fraction) for which the grid is
+/// finished; beyond it min and max cannot print the same.
+const SPREAD: f64 = 0.001;
+
 /// Runs checkBSDF.
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let items = spec().parse(&args)?;
@@ -186,27 +190,33 @@ fn report(name: &str, b: &Bsdf, colour: &[(Direction, [f64; 3])]) -> Result<Stri
     };
     if tree {
         // Radiance samples tree pairs at random; the rows are printed only where the sampling
-        // cannot change them (every pair's error the same to the printed precision).
-        let trec = |s: &mut String, label: &str, r: Option<Reciprocity>| match r {
-            Some(r) if format!("{:5.1}", 100.0 * r.min) != format!("{:5.1}", 100.0 * r.max) => {
+        // cannot change them (every pair's error the same to the printed precision). The grid
+        // is abandoned once two errors differ by more than 0.1%.
+        let trec = |s: &mut String, label: &str, r: Option<Option<Reciprocity>>| match r {
+            Some(Some(r))
+                if format!("{:5.1}", 100.0 * r.min) == format!("{:5.1}", 100.0 * r.max) =>
+            {
+                rec(s, label, Some(r))
+            }
+            Some(_) => {
                 let _ = writeln!(s, "{label}\t(not computed by fenestra for tensor trees)");
             }
-            _ => rec(s, label, r),
+            None => rec(s, label, None),
         };
         trec(
             &mut s,
             "Interior Refl",
-            check::tree::tree_reflection_reciprocity(b, Direction::ReflectionBack),
+            check::tree::tree_reflection_reciprocity(b, Direction::ReflectionBack, SPREAD),
         );
         trec(
             &mut s,
             "Exterior Refl",
-            check::tree::tree_reflection_reciprocity(b, Direction::ReflectionFront),
+            check::tree::tree_reflection_reciprocity(b, Direction::ReflectionFront, SPREAD),
         );
         trec(
             &mut s,
             "Transmission",
-            check::tree::tree_transmission_reciprocity(b),
+            check::tree::tree_transmission_reciprocity(b, SPREAD),
         );
     } else {
         rec(
