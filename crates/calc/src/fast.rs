@@ -1564,6 +1564,30 @@ mod tests {
         v
     }
 
+    /// Compiles `src` for rcalc and checks that its fast code gives the exact evaluator's
+    /// outcome on every pair (`$1`, `$2`) of `special` values; returns the fast program and
+    /// how many evaluations its fast code completed.
+    fn agree_on_pairs(src: &str, special: &[f64]) -> (Compiled, u64) {
+        let mut p = Program::for_rcalc();
+        p.load_str("-e", src).unwrap();
+        let fast = p.compile().unwrap();
+        let mut exact = fast.clone();
+        exact.fast.clear();
+        let (mut sf, mut se) = (fast.state(), exact.state());
+        for &a in special {
+            for &b in special {
+                let r = [a, b, 0.25];
+                assert_eq!(
+                    outcome(&fast, &mut sf, &r),
+                    outcome(&exact, &mut se, &r),
+                    "{r:?}"
+                );
+            }
+        }
+        let hits = sf.fast_hits;
+        (fast, hits)
+    }
+
     /// The fused comparisons and picks on NaNs, infinities, signed zeros and
     /// subnormals: the values of the exact evaluator.
     #[test]
@@ -1571,11 +1595,6 @@ mod tests {
         let src = "$1 = if($1 - $2, 1, 2); $2 = if($1 + 3, 5, $2); $3 = if(-$1, $3, 7);\n\
                    $4 = if($1 - $2, $1 - 1, $2 + 1); $5 = if(3 + $2, $1, $2);\n\
                    $6 = if($1 - 5e-324, -0, 0) + if($1 + -5e-324, 1, 0)*10;";
-        let mut p = Program::for_rcalc();
-        p.load_str("-e", src).unwrap();
-        let fast = p.compile().unwrap();
-        let mut exact = fast.clone();
-        exact.fast.clear();
         let special = [
             f64::NAN,
             -f64::NAN,
@@ -1590,33 +1609,18 @@ mod tests {
             1e308,
             -1e308,
         ];
-        let (mut sf, mut se) = (fast.state(), exact.state());
-        for &a in &special {
-            for &b in &special {
-                let r = [a, b, 0.25];
-                assert_eq!(
-                    outcome(&fast, &mut sf, &r),
-                    outcome(&exact, &mut se, &r),
-                    "{r:?}"
-                );
-            }
-        }
-        assert_eq!(sf.fast_hits, (special.len() * special.len() * 6) as u64);
+        let (_, hits) = agree_on_pairs(src, &special);
+        assert_eq!(hits, (special.len() * special.len() * 6) as u64);
     }
 
-    /// Random programs evaluated with and without fast code: the same values, errors
-    /// and warnings on every record.
+    /// The fused op pairs on special values (NaNs, infinities, signed zeros, subnormals,
+    /// values beyond 2^52): the exact evaluator's outcomes; every pair is formed.
     #[test]
     fn fused_pairs_agree_on_special_values() {
         let src = "$1 = floor($1 + $2); $2 = floor($1 - $2); $3 = floor($1 * $2);\n\
                    $4 = floor($1 / $2); $5 = 3*asin($1); $6 = $2*acos($1);\n\
                    $7 = -2*atan2($1, $2); $8 = if($1, 1, $2*$2) + 1;\n\
                    $9 = $1 + $2*3; $10 = $1*$2 + 3; $11 = 2 - $1*$2; $12 = ($1 + $2) + -0;";
-        let mut p = Program::for_rcalc();
-        p.load_str("-e", src).unwrap();
-        let fast = p.compile().unwrap();
-        let mut exact = fast.clone();
-        exact.fast.clear();
         let special = [
             f64::NAN,
             -f64::NAN,
@@ -1635,17 +1639,7 @@ mod tests {
             1e308,
             -1e308,
         ];
-        let (mut sf, mut se) = (fast.state(), exact.state());
-        for &a in &special {
-            for &b in &special {
-                let r = [a, b, 0.25];
-                assert_eq!(
-                    outcome(&fast, &mut sf, &r),
-                    outcome(&exact, &mut se, &r),
-                    "{r:?}"
-                );
-            }
-        }
+        let (fast, hits) = agree_on_pairs(src, &special);
         // every fused pair was made, and the fast code ran (a zero divisor gives up)
         let mut seen = [false; 12];
         for f in fast.fast.iter().filter_map(|f| f.get()).flatten() {
@@ -1669,7 +1663,7 @@ mod tests {
             }
         }
         assert_eq!(seen, [true; 12]);
-        assert!(sf.fast_hits > (special.len() * special.len() * 7) as u64);
+        assert!(hits > (special.len() * special.len() * 7) as u64);
     }
 
     #[test]
