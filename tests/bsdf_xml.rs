@@ -467,7 +467,21 @@ fn oracle_colour_with_lambertian_part() {
         .zip(&t.data)
         .map(|(w, g)| {
             (0..3)
-                .map(|ch| (g[ch] / w[ch] as f64 - 1.0).abs())
+                .map(|ch| {
+                    let (g, w) = (g[ch], w[ch] as f64);
+                    match (g == 0.0, w == 0.0) {
+                        (true, true) => 0.0,
+                        // f64::max would drop a NaN: count it as the largest difference
+                        _ => {
+                            let d = (g / w - 1.0).abs();
+                            if d.is_nan() {
+                                f64::INFINITY
+                            } else {
+                                d
+                            }
+                        }
+                    }
+                })
                 .fold(0.0, f64::max)
         })
         .collect();
