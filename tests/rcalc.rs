@@ -639,3 +639,19 @@ fn read_error_after_the_records_before_it() {
         );
     }
 }
+
+/// Input words as C's `atof` reads them: signed zeros, hexadecimal with fraction and binary
+/// exponent, numeric prefixes, `nan`, `inf`; the same output as the oracle's rcalc.
+#[test]
+fn oracle_input_words_read_as_c_atof() {
+    let Some(o) = common::oracle() else { return };
+    let input = b"-0\n0\n0x10\n-0x1.8p1\n0X1P-2\n0x\n1e3x\n-.5e1\nnan\n-inf\nabc\n";
+    for e in ["$1=$1", "$1=-$1;$2=$1*2"] {
+        let mut theirs = o.command("rcalc");
+        theirs.args(["-e", e]);
+        let (ok_o, out_o, _) = run_with(theirs, input);
+        let (ok_f, out_f, err_f) = run_with(ours(&["-e", e]), input);
+        assert!(ok_o && ok_f, "{e}: {err_f}");
+        assert_eq!(out_f, out_o, "{e}");
+    }
+}

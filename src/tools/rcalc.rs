@@ -61,46 +61,10 @@ fn parse_fmt(opt: &str, w: &str) -> Result<(Fmt, usize)> {
     Ok((f, n))
 }
 
-/// The longest numeric prefix of a word, as C's `atof` reads it (0 when none).
+/// The longest numeric prefix of a word, as C's `atof` reads it (0 when none; hexadecimal
+/// included): fenestra_cli::num::atof.
 pub fn atof(w: &str) -> f64 {
-    if let Ok(v) = w.parse::<f64>() {
-        return v;
-    }
-    let b = w.as_bytes();
-    let mut i = 0;
-    if i < b.len() && (b[i] == b'+' || b[i] == b'-') {
-        i += 1;
-    }
-    let mut digits = 0;
-    while i < b.len() && b[i].is_ascii_digit() {
-        i += 1;
-        digits += 1;
-    }
-    if i < b.len() && b[i] == b'.' {
-        i += 1;
-        while i < b.len() && b[i].is_ascii_digit() {
-            i += 1;
-            digits += 1;
-        }
-    }
-    if digits == 0 {
-        return 0.0;
-    }
-    let mut end = i;
-    if i < b.len() && (b[i] == b'e' || b[i] == b'E') {
-        let mut j = i + 1;
-        if j < b.len() && (b[j] == b'+' || b[j] == b'-') {
-            j += 1;
-        }
-        let s = j;
-        while j < b.len() && b[j].is_ascii_digit() {
-            j += 1;
-        }
-        if j > s {
-            end = j;
-        }
-    }
-    w[..end].parse().unwrap_or(0.0)
+    fenestra_cli::num::atof(w)
 }
 
 /// How a record's output line is produced: one per thread.

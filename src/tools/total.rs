@@ -132,90 +132,15 @@ fn parse(args: &[String]) -> Result<(Opts, Vec<String>)> {
     Ok((o, files))
 }
 
-/// C `atof`: the longest numeric prefix (decimal or hexadecimal, `inf`), 0 when there is
-/// none; `nan` counts as 0 (what Radiance's total makes of it in sums).
+/// C `atof` (fenestra_cli::num::atof), with `nan` counting as 0 (what Radiance's total
+/// makes of it in sums).
 fn atof(s: &str) -> f64 {
-    let b = s.trim_start().as_bytes();
-    let mut i = 0;
-    let neg = match b.first() {
-        Some(b'-') => {
-            i += 1;
-            true
-        }
-        Some(b'+') => {
-            i += 1;
-            false
-        }
-        _ => false,
-    };
-    let sign = if neg { -1.0 } else { 1.0 };
-    let rest = &b[i..];
-    let lower: Vec<u8> = rest
-        .iter()
-        .take(3)
-        .map(|c| c.to_ascii_lowercase())
-        .collect();
-    if lower == b"inf" {
-        return sign * f64::INFINITY;
+    let v = fenestra_cli::num::atof(s);
+    if v.is_nan() {
+        0.0
+    } else {
+        v
     }
-    if lower == b"nan" {
-        return 0.0;
-    }
-    if rest.len() > 2 && rest[0] == b'0' && (rest[1] | 0x20) == b'x' && rest[2].is_ascii_hexdigit()
-    {
-        let mut v = 0.0f64;
-        let mut j = 2;
-        while j < rest.len() && rest[j].is_ascii_hexdigit() {
-            v = v * 16.0 + (rest[j] as char).to_digit(16).unwrap_or(0) as f64;
-            j += 1;
-        }
-        if j < rest.len() && rest[j] == b'.' {
-            j += 1;
-            let mut scale = 1.0 / 16.0;
-            while j < rest.len() && rest[j].is_ascii_hexdigit() {
-                v += (rest[j] as char).to_digit(16).unwrap_or(0) as f64 * scale;
-                scale /= 16.0;
-                j += 1;
-            }
-        }
-        return sign * v;
-    }
-    let mut j = 0;
-    let digits = |j: &mut usize| {
-        let s = *j;
-        while *j < rest.len() && rest[*j].is_ascii_digit() {
-            *j += 1;
-        }
-        *j - s
-    };
-    let mut nd = digits(&mut j);
-    if j < rest.len() && rest[j] == b'.' {
-        j += 1;
-        nd += digits(&mut j);
-    }
-    if nd == 0 {
-        return 0.0;
-    }
-    let mant_end = j;
-    if j < rest.len() && (rest[j] | 0x20) == b'e' {
-        let mut k = j + 1;
-        if k < rest.len() && (rest[k] == b'+' || rest[k] == b'-') {
-            k += 1;
-        }
-        if digits(&mut k) > 0 {
-            j = k;
-        }
-    }
-    let text = std::str::from_utf8(&rest[..j]).unwrap_or("0");
-    let v = text
-        .parse::<f64>()
-        .or_else(|_| {
-            std::str::from_utf8(&rest[..mant_end])
-                .unwrap_or("0")
-                .parse()
-        })
-        .unwrap_or(0.0);
-    sign * v
 }
 
 /// Accumulators for one result.

@@ -4,6 +4,7 @@
 
 pub mod expand;
 pub mod input;
+pub mod num;
 pub mod opts;
 pub mod output;
 pub mod progress;
