@@ -655,3 +655,28 @@ fn oracle_input_words_read_as_c_atof() {
         assert_eq!(out_f, out_o, "{e}");
     }
 }
+
+/// Zeros as Radiance's calcomp treats them: a literal or `:` constant zero times, over or to
+/// the power of anything is that zero without evaluating the rest (`0*x`, `x*0`, `0/x`,
+/// `0^x`, also inside function bodies); a division by zero at run time gives the signed zero
+/// divisor with a warning. Each program of tests/fixtures/rcalc/zero_rules.txt on records with
+/// signed zeros, infinities and NaN: the oracle's output and number of warnings.
+#[test]
+fn oracle_zero_rules() {
+    let Some(o) = common::oracle() else { return };
+    let progs = std::fs::read_to_string(common::fixture("rcalc/zero_rules.txt")).unwrap();
+    let input = b"-0 inf\n0 nan\n-3 -0\n";
+    let warnings = |err: &str| err.matches("Division by zero").count();
+    let mut n = 0;
+    for e in progs.lines().filter(|l| !l.trim().is_empty()) {
+        let mut theirs = o.command("rcalc");
+        theirs.args(["-e", e]);
+        let (ok_o, out_o, err_o) = run_with(theirs, input);
+        let (ok_f, out_f, err_f) = run_with(ours(&["-e", e]), input);
+        assert!(ok_o && ok_f, "{e}: {err_f}");
+        assert_eq!(out_f, out_o, "{e}");
+        assert_eq!(warnings(&err_f), warnings(&err_o), "{e}: {err_f} vs {err_o}");
+        n += 1;
+    }
+    assert_eq!(n, 28);
+}

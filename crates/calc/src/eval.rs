@@ -785,7 +785,8 @@ impl Compiled {
                 if b == 0.0 {
                     st.warnings.division_by_zero += 1;
                     st.set_errno(ErrFlag::Range);
-                    0.0
+                    // Radiance's result is the (signed) zero divisor: 1/-0 gives -0
+                    b
                 } else {
                     a / b
                 }

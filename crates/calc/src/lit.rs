@@ -1,7 +1,9 @@
 //! What Radiance's parser does with constants while it reads a definition (unless
 //! disabled, as rcalc's `-n` does for the definitions that follow it): sub-expressions
 //! made only of literals (and built-in calls on them) are replaced by their values,
-//! `x - c` becomes `x + (-c)` and `x / c` becomes `x * (1/c)`. An error while folding
+//! `x - c` becomes `x + (-c)` and `x / c` becomes `x * (1/c)`; a literal zero times, over or
+//! to the power of anything is that zero (`0*x`, `x*0`, `0/x`, `0^x`; checked against the
+//! oracle's rcalc, signed zeros included). An error while folding
 //! (division by zero, `select` out of range) is fatal: "bad constant expression";
 //! dividing by a literal zero is fatal too: "divide by zero constant".
 
@@ -74,9 +76,19 @@ impl Cx<'_> {
                         BinOp::Div => x / y,
                         BinOp::Pow => x.powf(y),
                     })),
+                    // A literal zero times, over or to the power of anything is that zero
+                    // (the other side is never evaluated), as Radiance's parser folds it.
+                    (Lit::Value(x), Lit::Not)
+                        if x == 0.0 && matches!(op, BinOp::Mul | BinOp::Div | BinOp::Pow) =>
+                    {
+                        Ok(Lit::Value(x))
+                    }
                     (Lit::Value(x), Lit::Not) => {
                         **a = Expr::Num(x);
                         Ok(Lit::Not)
+                    }
+                    (Lit::Not, Lit::Value(y)) if y == 0.0 && *op == BinOp::Mul => {
+                        Ok(Lit::Value(y))
                     }
                     (Lit::Not, Lit::Value(y)) => {
                         match op {
