@@ -675,7 +675,11 @@ fn oracle_zero_rules() {
         let (ok_f, out_f, err_f) = run_with(ours(&["-e", e]), input);
         assert!(ok_o && ok_f, "{e}: {err_f}");
         assert_eq!(out_f, out_o, "{e}");
-        assert_eq!(warnings(&err_f), warnings(&err_o), "{e}: {err_f} vs {err_o}");
+        assert_eq!(
+            warnings(&err_f),
+            warnings(&err_o),
+            "{e}: {err_f} vs {err_o}"
+        );
         n += 1;
     }
     assert_eq!(n, 28);

@@ -87,9 +87,7 @@ impl Cx<'_> {
                         **a = Expr::Num(x);
                         Ok(Lit::Not)
                     }
-                    (Lit::Not, Lit::Value(y)) if y == 0.0 && *op == BinOp::Mul => {
-                        Ok(Lit::Value(y))
-                    }
+                    (Lit::Not, Lit::Value(y)) if y == 0.0 && *op == BinOp::Mul => Ok(Lit::Value(y)),
                     (Lit::Not, Lit::Value(y)) => {
                         match op {
                             BinOp::Sub => {
