@@ -695,12 +695,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                         let text = line.strip_suffix(b"\n").unwrap_or(&line);
                         line_cols(text, sep, count, &mut cols)
                             .with_context(|| format!("reading {f}"))?;
-                        ev.st.set_chans(&cols);
-                        ev.record(&mut buf)?;
-                        ev.print_warnings();
-                        out.write_all(&buf)?;
-                        buf.clear();
-                        out.flush()?;
+                        flush_record(&mut ev, &cols, &mut buf, &mut out)?;
                     }
                 }
                 Framing::Binary { n, size } => {
@@ -718,12 +713,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                             _ => {}
                         }
                         binary_cols(&rec, size, &mut cols);
-                        ev.st.set_chans(&cols);
-                        ev.record(&mut buf)?;
-                        ev.print_warnings();
-                        out.write_all(&buf)?;
-                        buf.clear();
-                        out.flush()?;
+                        flush_record(&mut ev, &cols, &mut buf, &mut out)?;
                     }
                 }
             }
@@ -738,6 +728,22 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     out.write_all(&buf)?;
     out.flush()?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// `-u`: evaluates one record and writes its output (and warnings) at once.
+fn flush_record(
+    ev: &mut Eval,
+    cols: &[f64],
+    buf: &mut Vec<u8>,
+    out: &mut impl Write,
+) -> Result<()> {
+    ev.st.set_chans(cols);
+    ev.record(buf)?;
+    ev.print_warnings();
+    out.write_all(buf)?;
+    buf.clear();
+    out.flush()?;
+    Ok(())
 }
 
 fn read_full(r: &mut dyn Read, buf: &mut [u8]) -> Result<usize> {

@@ -445,20 +445,9 @@ mod tests {
     use super::*;
 
     #[test]
-    fn atof_takes_the_numeric_prefix() {
-        for (s, v) in [
-            ("12abc", 12.0),
-            ("0x10", 16.0),
-            (".5e1", 5.0),
-            ("+3", 3.0),
-            ("-.5", -0.5),
-            ("1e", 1.0),
-            ("5e+", 5.0),
-            ("abc", 0.0),
-            ("", 0.0),
-            (" 7 ", 7.0),
-            ("nan", 0.0),
-        ] {
+    fn atof_is_c_atof_with_nan_as_zero() {
+        // the numeric prefixes themselves are tested in fenestra_cli::num
+        for (s, v) in [("12abc", 12.0), ("0x10", 16.0), ("abc", 0.0), ("nan", 0.0)] {
             assert_eq!(atof(s), v, "{s}");
         }
         assert_eq!(atof("-inf"), f64::NEG_INFINITY);
