@@ -1382,15 +1382,19 @@ fn oracle_limited_ray_distance() {
     );
 
     let Some(o) = common::oracle() else { return };
-    for (scene, opts, input) in [
-        (&opaque, vec!["-ld+"], &rays[..]),
-        (&opaque, vec!["-ld-"], &rays[..]),
+    // the last case sees the pane's reflection: 7 printed digits, and the glass
+    // reflectance at oblique incidence may differ in the last one (Radiance computes the
+    // Fresnel terms in single precision); the others must be identical
+    for (scene, opts, input, tol) in [
+        (&opaque, vec!["-ld+"], &rays[..], 0.0),
+        (&opaque, vec!["-ld-"], &rays[..], 0.0),
         (
             &glazed,
             vec!["-i+", "-ld+"],
             &b"0 0 0 0 2.9 0\n0 0 0 0 3.1 0\n"[..],
+            0.0,
         ),
-        (&glazed, vec!["-ld+"], &through[..]),
+        (&glazed, vec!["-ld+"], &through[..], 2e-7),
     ] {
         let oct = oracle_octree(&o, &dir, &[scene.display().to_string()]);
         let mut a = vec!["-w", "-h", "-ab", "0"];
@@ -1403,10 +1407,8 @@ fn oracle_limited_ray_distance() {
         let got = ours(scene, &opts, input);
         assert_eq!(got.len(), want.len(), "{opts:?}");
         for (g, w) in got.iter().zip(&want) {
-            // 7 printed digits; the glass reflectance at oblique incidence may differ in
-            // the last one (Radiance computes the Fresnel terms in single precision)
             assert!(
-                (g - w).abs() <= 2e-7 * w.abs(),
+                (g - w).abs() <= tol * w.abs(),
                 "{opts:?}: {got:?} vs {want:?}"
             );
         }

@@ -413,7 +413,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     });
 
     // -ld+ (not with -I, which ignores the length as Radiance does)
-    let stops = limit_dist && !irr;
+    let limit = limit_dist && !irr;
 
     // Input.
     let expect = if yres > 0 {
@@ -431,7 +431,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     if dynamic {
         let probe_opts = RunOptions {
             irradiance_at_hit: hit_kinds.clone(),
-            limit_dist: stops,
+            limit_dist: limit,
             irradiance: irr,
             value,
             // the same random streams as the main pass: replicas with -E -c 1, ray
@@ -581,7 +581,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
 
     let opts = RunOptions {
         irradiance_at_hit: hit_kinds,
-        limit_dist: stops,
+        limit_dist: limit,
         irradiance: irr,
         value,
         count,

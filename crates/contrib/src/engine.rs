@@ -337,20 +337,20 @@ impl<'a> Engine<'a> {
             self.tracer
                 .contributions_irradiance(index, ray.org, ray.dir, &self.tracked, &mut sink);
         } else {
-            if self.opts.limit_dist {
-                // -ld+: the ray ends at the length of its direction vector
-                self.tracer.contributions_limited(
-                    index,
-                    ray.org,
-                    ray.dir,
-                    ray.dir.length(),
-                    &self.tracked,
-                    &mut sink,
-                );
-                return;
-            }
-            self.tracer
-                .contributions(index, ray.org, ray.dir, &self.tracked, &mut sink);
+            // -ld+: the ray ends at the length of its direction vector
+            let len = if self.opts.limit_dist {
+                ray.dir.length()
+            } else {
+                f64::INFINITY
+            };
+            self.tracer.contributions_limited(
+                index,
+                ray.org,
+                ray.dir,
+                len,
+                &self.tracked,
+                &mut sink,
+            );
         }
     }
 

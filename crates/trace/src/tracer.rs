@@ -832,11 +832,11 @@ impl Tracer {
                 let p = r.org + r.dir * h.t;
                 let n = self.accel.shapes[h.shape].normal(p);
                 let m = self.surf_mat[h.shape];
-                if !r.clip.is_empty() && r.clip.contains(m) {
+                if r.clip.contains(m) {
                     // inside antimatter: this surface is not there
                     let mut c = r.clone();
                     c.clip.cross(m, r.dir.dot(n) < 0.0);
-                    return self.pass(&c, h.shape, p, h.t, cx);
+                    return self.pass(c, h.shape, p, h.t, cx);
                 }
                 let (val, zeroed) = self.shade(r, m, h.shape, p, n, h.t, cx);
                 self.report(cx, r, self.surf_prim[h.shape], val, p, n, h.t, zeroed);
@@ -854,9 +854,8 @@ impl Tracer {
     }
 
     /// Continues a ray straight through the surface it hit.
-    fn pass(&self, r: &Ray, shape: usize, p: DVec3, t: f64, cx: &mut Ctx) -> DVec3 {
+    fn pass(&self, mut c: Ray, shape: usize, p: DVec3, t: f64, cx: &mut Ctx) -> DVec3 {
         let flat = self.accel.shapes[shape].is_flat();
-        let mut c = r.clone();
         c.org = p;
         c.skip = flat.then_some(shape);
         c.start += t;
@@ -956,23 +955,24 @@ impl Tracer {
         t: f64,
         cx: &mut Ctx,
     ) -> DVec3 {
-        let mut c = r.clone();
-        if r.dir.dot(n) < 0.0 {
-            for &m in mods {
-                // a ninth simultaneous modifier is not clipped (MAX_CLIP)
-                c.clip.insert(m);
-            }
-        } else {
+        let entering = r.dir.dot(n) < 0.0;
+        if !entering {
             if let Some(f) = first {
                 if r.clip.inside(f) {
                     return self.shade(r, f, shape, p, -n, t, cx).0;
                 }
             }
-            for &m in mods {
+        }
+        let mut c = r.clone();
+        for &m in mods {
+            if entering {
+                // a ninth simultaneous modifier is not clipped (MAX_CLIP)
+                c.clip.insert(m);
+            } else {
                 c.clip.remove(m);
             }
         }
-        self.pass(&c, shape, p, t, cx)
+        self.pass(c, shape, p, t, cx)
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -1030,7 +1030,7 @@ impl Tracer {
                             let n = self.accel.shapes[shape].normal(p);
                             self.shade(r, *a, shape, p, n, t, cx)
                         }
-                        None => (self.pass(r, shape, p, t, cx), false),
+                        None => (self.pass(r.clone(), shape, p, t, cx), false),
                     };
                 }
             }
