@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use fenestra_calc::format::push_g;
 use fenestra_calc::{Compiled, Program, State, VarId};
+use fenestra_cli::num::atof;
 use fenestra_cli::opts::{Item, Kind, Opt, Spec};
 
 fn spec() -> Spec {
@@ -59,12 +60,6 @@ fn parse_fmt(opt: &str, w: &str) -> Result<(Fmt, usize)> {
             .with_context(|| format!("option -{opt}{w}: bad count '{rest}'"))?
     };
     Ok((f, n))
-}
-
-/// The longest numeric prefix of a word, as C's `atof` reads it (0 when none; hexadecimal
-/// included): fenestra_cli::num::atof.
-pub fn atof(w: &str) -> f64 {
-    fenestra_cli::num::atof(w)
 }
 
 /// How a record's output line is produced: one per thread.
@@ -247,6 +242,7 @@ fn digit_run(buf: &[u8], mut i: usize, m: &mut u64, nd: &mut u32) -> usize {
 }
 
 /// A plain decimal word (see [`plain_at`]).
+#[cfg(test)]
 fn parse_plain(w: &[u8]) -> Option<f64> {
     plain_at(w, 0)
         .filter(|&(_, e)| e == w.len())
@@ -282,11 +278,8 @@ fn ws_line(buf: &[u8], cols: &mut Vec<f64>) -> Result<usize> {
     }
 }
 
-/// A word's value as C's `atof` reads it (see [`atof`]).
+/// A word's value as C's `atof` reads it (called where [`plain_at`] did not read it).
 fn word_value(w: &[u8]) -> Result<f64> {
-    if let Some(v) = parse_plain(w) {
-        return Ok(v);
-    }
     let s = std::str::from_utf8(w)
         .map_err(|_| anyhow::anyhow!("stream did not contain valid UTF-8"))?;
     Ok(atof(s))
