@@ -615,26 +615,18 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         if dummies > 0 && warnings {
             fenestra_cli::warn("dummy ray(s) ignored during accumulation");
         }
-        let rec = engine.sum_all(&rays, &pool, &|n| progress.inc(n))?;
-        if reload {
-            for (s, prev) in streams.iter_mut().zip(&previous) {
-                // write_record asks for the stream's items in order
-                let item = std::cell::Cell::new(0);
-                s.write_record(fout, rec.scale, |m, b| {
-                    let k = engine.slot(m, b) * 3;
-                    let mut v = [rec.sums[k], rec.sums[k + 1], rec.sums[k + 2]];
-                    if let Some(p) = prev {
-                        let i = item.replace(item.get() + 1);
-                        for (c, x) in v.iter_mut().enumerate() {
-                            *x += p[i][c] / rec.scale;
-                        }
-                    }
-                    v
-                })?;
+        let mut rec = engine.sum_all(&rays, &pool, &|n| progress.inc(n))?;
+        // -r: the sums the files hold are added to this run's
+        for (s, prev) in streams.iter().zip(&previous) {
+            let Some(p) = prev else { continue };
+            for (&(m, b), v) in s.plan.items.iter().zip(p) {
+                let k = engine.slot(m, b) * 3;
+                for c in 0..3 {
+                    rec.sums[k + c] += v[c] / rec.scale;
+                }
             }
-        } else {
-            write(&rec, &mut streams, &mut err_streams)?;
         }
+        write(&rec, &mut streams, &mut err_streams)?;
     } else {
         let nrec = rays.len().div_ceil(count);
         if rays.len() % count != 0 && warnings {
