@@ -621,8 +621,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             let Some(p) = prev else { continue };
             for (&(m, b), v) in s.plan.items.iter().zip(p) {
                 let k = engine.slot(m, b) * 3;
-                for c in 0..3 {
-                    rec.sums[k + c] += v[c] / rec.scale;
+                for (sum, x) in rec.sums[k..k + 3].iter_mut().zip(v) {
+                    *sum += x / rec.scale;
                 }
             }
         }
