@@ -5,6 +5,7 @@
 //! the rules mgf2rad applies (light, glass, trans, plastic, metal); names follow its
 //! scheme (`object.a<k>.object.f<n>`).
 
+use crate::transform::invert3;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -84,25 +85,6 @@ fn xyz_to_rgb() -> [[f64; 3]; 3] {
         }
     }
     invert3(&m)
-}
-
-fn det3(m: &[[f64; 3]; 3]) -> f64 {
-    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
-}
-
-fn invert3(m: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
-    let d = det3(m);
-    let mut r = [[0.0; 3]; 3];
-    for (i, row) in r.iter_mut().enumerate() {
-        for (j, v) in row.iter_mut().enumerate() {
-            let (a, b) = ((j + 1) % 3, (j + 2) % 3);
-            let (c, e) = ((i + 1) % 3, (i + 2) % 3);
-            *v = (m[a][c] * m[b][e] - m[a][e] * m[b][c]) / d;
-        }
-    }
-    r
 }
 
 fn solve3(m: &[[f64; 3]; 3], b: [f64; 3]) -> [f64; 3] {

@@ -92,24 +92,20 @@ impl Transform {
     /// The inverse transform (scale `1/sca`); `None` when the matrix is singular (`-s 0`).
     pub fn inverse(&self) -> Option<Transform> {
         let a = &self.m;
-        let cof = |r0: usize, r1: usize, c0: usize, c1: usize| {
-            a[r0][c0] * a[r1][c1] - a[r0][c1] * a[r1][c0]
-        };
-        let det = a[0][0] * cof(1, 2, 1, 2) - a[0][1] * cof(1, 2, 0, 2) + a[0][2] * cof(1, 2, 0, 1);
+        let lin = [
+            [a[0][0], a[0][1], a[0][2]],
+            [a[1][0], a[1][1], a[1][2]],
+            [a[2][0], a[2][1], a[2][2]],
+        ];
+        let det = det3(&lin);
         if det == 0.0 || !det.is_finite() || self.sca == 0.0 {
             return None;
         }
-        // Inverse of the 3×3 linear part (adjugate / determinant).
+        let l = invert3(&lin);
         let mut inv = IDENTITY;
-        inv[0][0] = cof(1, 2, 1, 2) / det;
-        inv[0][1] = -cof(0, 2, 1, 2) / det;
-        inv[0][2] = cof(0, 1, 1, 2) / det;
-        inv[1][0] = -cof(1, 2, 0, 2) / det;
-        inv[1][1] = cof(0, 2, 0, 2) / det;
-        inv[1][2] = -cof(0, 1, 0, 2) / det;
-        inv[2][0] = cof(1, 2, 0, 1) / det;
-        inv[2][1] = -cof(0, 2, 0, 1) / det;
-        inv[2][2] = cof(0, 1, 0, 1) / det;
+        for (row, lr) in inv.iter_mut().zip(&l) {
+            row[..3].copy_from_slice(lr);
+        }
         // p = (p' − t)·A⁻¹: the translation row is −t·A⁻¹.
         for j in 0..3 {
             inv[3][j] = -(a[3][0] * inv[0][j] + a[3][1] * inv[1][j] + a[3][2] * inv[2][j]);
@@ -215,6 +211,27 @@ impl Transform {
         }
         Ok(t)
     }
+}
+
+/// Determinant of a 3×3 matrix.
+pub(crate) fn det3(m: &[[f64; 3]; 3]) -> f64 {
+    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+}
+
+/// Inverse of a 3×3 matrix (adjugate over determinant; the caller checks the determinant).
+pub(crate) fn invert3(m: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    let d = det3(m);
+    let mut r = [[0.0; 3]; 3];
+    for (i, row) in r.iter_mut().enumerate() {
+        for (j, v) in row.iter_mut().enumerate() {
+            let (a, b) = ((j + 1) % 3, (j + 2) % 3);
+            let (c, e) = ((i + 1) % 3, (i + 2) % 3);
+            *v = (m[a][c] * m[b][e] - m[a][e] * m[b][c]) / d;
+        }
+    }
+    r
 }
 
 fn repeat(total: &Transform, group: &Transform, reps: i64) -> Transform {
