@@ -302,10 +302,10 @@ impl Component<'_> {
         ]
     }
 
-    /// Lambertian value split off (grey: the matrix minimum when above 0.01/π; coloured: the
-    /// sum of the sharp-RGB minima) and its RGB, with whether the remainder is kept (its largest
+    /// RGB of the Lambertian part split off (grey: the matrix minimum when above 0.01/π;
+    /// coloured: from the sharp-RGB minima), with whether the remainder is kept (its largest
     /// hemispherical total exceeds 0.001).
-    fn split(&self) -> (f64, [f64; 3], bool) {
+    fn split(&self) -> ([f64; 3], bool) {
         match &self.colour {
             Some(Colour {
                 remainder: Some(rest),
@@ -322,21 +322,14 @@ impl Component<'_> {
                         .sum();
                     h > 0.001
                 });
-                let lum = rgb_luminance(*lambertian);
-                (lum, *lambertian, keep)
+                (*lambertian, keep)
             }
             _ => {
                 let (lamb, keep) = lambertian_split(self.y);
-                (lamb, [lamb; 3], keep)
+                ([lamb; 3], keep)
             }
         }
     }
-}
-
-/// CIE Y of an RGB colour (Radiance's standard primaries).
-fn rgb_luminance(rgb: [f64; 3]) -> f64 {
-    let m = inv3(&xyz_to_rgb_matrix());
-    m[1][0] * rgb[0] + m[1][1] * rgb[1] + m[1][2] * rgb[2]
 }
 
 /// The order in which Radiance encodes the coloured components (rf, rb, tf, tb).
@@ -347,22 +340,29 @@ const ENCODE_ORDER: [Direction; 4] = [
     Direction::TransmissionFront,
 ];
 
-/// Component `d` of `b`, encoding the colour of every coloured component with `rng` (as
-/// Radiance's loader does whichever component is asked for).
-fn component<'a>(
-    b: &'a Bsdf,
-    d: Direction,
-    rng: &mut Drand48,
-) -> Result<Option<Component<'a>>, MatrixError> {
-    let mut found = None;
-    for dir in ENCODE_ORDER {
+/// What Radiance's loader makes of one direction of a BSDF.
+enum Slot<'a> {
+    /// No visible-light Klems or tree block.
+    Absent,
+    /// A tensor tree (no matrix).
+    Tree,
+    /// CIE-X/CIE-Z blocks on other bases than the Y block.
+    BadBasis,
+    /// A Klems component.
+    Klems(Component<'a>),
+}
+
+/// Every component of `b` as Radiance's loader prepares it, encoding the colour of each
+/// coloured component with `rng` in rf rb tf tb order (whichever component is asked for
+/// afterwards); indexed like [`ENCODE_ORDER`].
+fn encode_all<'a>(b: &'a Bsdf, rng: &mut Drand48) -> [Slot<'a>; 4] {
+    ENCODE_ORDER.map(|dir| {
         let Some(blk) = b.block(dir, &Wavelength::Visible) else {
-            continue;
+            return Slot::Absent;
         };
         let y = match &blk.data {
             crate::model::BlockData::Klems(m) => m,
-            crate::model::BlockData::Tree(_) if dir == d => return Err(MatrixError::TensorTree),
-            crate::model::BlockData::Tree(_) => continue,
+            crate::model::BlockData::Tree(_) => return Slot::Tree,
         };
         let x = b.klems(dir, &Wavelength::CieX);
         let z = b.klems(dir, &Wavelength::CieZ);
@@ -370,10 +370,7 @@ fn component<'a>(
             m.is_none_or(|m| m.incident == y.incident && m.outgoing == y.outgoing)
         };
         if !same(x) || !same(z) {
-            if dir == d {
-                return Err(MatrixError::ColourBasis(d.xml_name()));
-            }
-            continue;
+            return Slot::BadBasis;
         }
         let m = xyz_to_rgb_matrix();
         let colour = match (x, z) {
@@ -391,11 +388,19 @@ fn component<'a>(
             }
             _ => None,
         };
-        if dir == d {
-            found = Some(Component { y, colour, m });
-        }
+        Slot::Klems(Component { y, colour, m })
+    })
+}
+
+/// Component `d` out of [`encode_all`]'s result.
+fn take<'a>(slots: &mut [Slot<'a>; 4], d: Direction) -> Result<Option<Component<'a>>, MatrixError> {
+    let k = ENCODE_ORDER.iter().position(|&e| e == d).unwrap_or(0);
+    match std::mem::replace(&mut slots[k], Slot::Absent) {
+        Slot::Absent => Ok(None),
+        Slot::Tree => Err(MatrixError::TensorTree),
+        Slot::BadBasis => Err(MatrixError::ColourBasis(d.xml_name())),
+        Slot::Klems(c) => Ok(Some(c)),
     }
-    Ok(found)
 }
 
 /// Radiance's load sequence for `b` (colour encoding and Lambertian split of every coloured Klems
@@ -403,13 +408,10 @@ fn component<'a>(
 /// (sr⁻¹) of the coloured Lambertian part split off. `rng` ends where Radiance's would after
 /// loading the file (a process keeps one generator for all the files it loads).
 pub fn colour_lambertians(b: &Bsdf, rng: &mut Drand48) -> Vec<(Direction, [f64; 3])> {
-    let start = rng.clone();
+    let slots = encode_all(b, rng);
     let mut out = Vec::new();
-    for d in ENCODE_ORDER {
-        let mut r = start.clone();
-        let c = component(b, d, &mut r);
-        *rng = r;
-        let Ok(Some(c)) = c else { continue };
+    for (d, slot) in ENCODE_ORDER.into_iter().zip(&slots) {
+        let Slot::Klems(c) = slot else { continue };
         if let Some(col) = c.colour.as_ref().filter(|c| c.remainder.is_some()) {
             out.push((d, mul3(&inv3(&c.m), col.lambertian)));
         }
@@ -445,15 +447,15 @@ pub fn transmission_matrix(b: &Bsdf) -> Result<RgbMatrix, MatrixError> {
 /// [`transmission_matrix`] with the colour dither drawn from `rng` (a Radiance process keeps
 /// one generator for all the BSDFs it loads).
 pub fn transmission_matrix_with(b: &Bsdf, rng: &mut Drand48) -> Result<RgbMatrix, MatrixError> {
-    // Radiance encodes every component once on load: both look-ups start from the same state.
-    let start = rng.clone();
-    let tb = component(b, Direction::TransmissionFront, rng)?;
+    // Radiance encodes every component once on load
+    let mut slots = encode_all(b, rng);
+    let tb = take(&mut slots, Direction::TransmissionFront)?;
     let tf = match tb {
-        None => component(b, Direction::TransmissionBack, &mut start.clone())?,
+        None => take(&mut slots, Direction::TransmissionBack)?,
         Some(_) => None,
     };
     if let Some(tb) = tb {
-        let (_, lamb, keep) = tb.split();
+        let (lamb, keep) = tb.split();
         if keep {
             let (ni, no) = (tb.y.incident.len(), tb.y.outgoing.len());
             let lam = tb.y.incident.lambdas();
@@ -469,7 +471,7 @@ pub fn transmission_matrix_with(b: &Bsdf, rng: &mut Drand48) -> Result<RgbMatrix
         return Ok(lambertian_only(lamb));
     }
     if let Some(tf) = tf {
-        let (_, lamb, keep) = tf.split();
+        let (lamb, keep) = tf.split();
         if keep {
             let (ni, no) = (tf.y.incident.len(), tf.y.outgoing.len());
             // Rows of T: tf incident patches; columns: tf outgoing patches.
@@ -527,7 +529,7 @@ pub fn reflection_matrix_with(
     } else {
         Direction::ReflectionFront
     };
-    let Some(r) = component(b, d, rng)? else {
+    let Some(r) = take(&mut encode_all(b, rng), d)? else {
         return Ok(None);
     };
     let (ni, no) = (r.y.incident.len(), r.y.outgoing.len());
