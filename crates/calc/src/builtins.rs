@@ -177,6 +177,17 @@ pub fn yn(n: f64, x: f64) -> f64 {
     unsafe { libm::yn(n as i32, x) }
 }
 
+/// `select`'s index: `(int)(x + .5)`, `None` for NaN, below −0.5 or from 2^31 on (an
+/// error in Radiance).
+#[inline]
+pub fn select_index(x: f64) -> Option<usize> {
+    if x.is_nan() || x < -0.5 || x + 0.5 >= 2147483648.0 {
+        None
+    } else {
+        Some((x + 0.5) as i64 as usize)
+    }
+}
+
 /// Radiance's `rand(x)`: a deterministic hash of `x` into [0, 1).
 #[inline]
 #[allow(clippy::approx_constant)] // Radiance's truncated constants, kept for identical output

@@ -575,10 +575,9 @@ impl<'a> Fc<'a> {
         let ri = self.node(&args[0], fr)?;
         let count = args.len() - 1;
         if let Some(x) = self.kval(ri) {
-            if x.is_nan() || x < -0.5 || x + 0.5 >= 2147483648.0 {
+            let Some(i) = builtins::select_index(x) else {
                 return self.abort();
-            }
-            let i = (x + 0.5) as i64 as usize;
+            };
             if i == 0 {
                 return Ok(self.k(count as f64));
             }
@@ -1421,10 +1420,7 @@ impl Fast {
                 }
                 Op::Select { d, i, l, n } => {
                     let x = r[i as usize];
-                    if x.is_nan() || x < -0.5 || x + 0.5 >= 2147483648.0 {
-                        return None;
-                    }
-                    let k = (x + 0.5) as i64 as usize;
+                    let k = builtins::select_index(x)?;
                     if k > n as usize {
                         return None;
                     }
@@ -1437,10 +1433,7 @@ impl Fast {
                 }
                 Op::SelectK { d, i, t, n } => {
                     let x = r[i as usize];
-                    if x.is_nan() || x < -0.5 || x + 0.5 >= 2147483648.0 {
-                        return None;
-                    }
-                    let k = (x + 0.5) as i64 as usize;
+                    let k = builtins::select_index(x)?;
                     if k == 0 {
                         r[d as usize] = n as f64;
                     } else if k > n as usize {

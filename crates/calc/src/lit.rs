@@ -156,11 +156,7 @@ impl Cx<'_> {
                     }
                     Builtin::Rand => Lit::Value(builtins::rand_hash(vals[0])),
                     Builtin::Select => {
-                        let n = vals[0];
-                        if n.is_nan() || n < -0.5 || n + 0.5 >= 2147483648.0 {
-                            return Err(Refused::BadConstant);
-                        }
-                        let i = (n + 0.5) as usize;
+                        let i = builtins::select_index(vals[0]).ok_or(Refused::BadConstant)?;
                         if i == 0 {
                             Lit::Value((vals.len() - 1) as f64)
                         } else if i < vals.len() {
