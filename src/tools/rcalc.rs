@@ -570,8 +570,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             },
         }
     }
-    let ids = prog.bind_vars(&["recno", "outno"]);
-    let exe = prog.compile().map_err(anyhow::Error::new)?;
+    let (exe, recno, outno, independent) = compile_program(prog)?;
     let maxchan = exe.channels().last().copied().unwrap_or(0) as usize;
     let mut outs = vec![false; maxchan];
     for n in exe.channels() {
@@ -579,11 +578,6 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     }
     let cond = exe.var("cond");
     let sep_out = sep.clone().unwrap_or_else(|| "\t".into());
-    let (recno, outno) = (ids[0], ids[1]);
-    // records are independent unless a definition counts them or a `:` constant keeps
-    // the value of the first record
-    let independent =
-        !exe.references_var(recno) && !exe.references_var(outno) && !exe.has_late_constants();
     let mk = |counters: bool| Eval {
         exe: &exe,
         st: exe.state(),
@@ -739,6 +733,18 @@ fn flush_record(
     Ok(())
 }
 
+/// Compiles rcalc's program with `recno` and `outno` bound; also says whether its records
+/// are independent (so blocks of them may be evaluated on several threads): not when a
+/// definition counts them or a `:` constant keeps the value of the first record.
+fn compile_program(mut prog: Program) -> Result<(Compiled, VarId, VarId, bool)> {
+    let ids = prog.bind_vars(&["recno", "outno"]);
+    let exe = prog.compile().map_err(anyhow::Error::new)?;
+    let (recno, outno) = (ids[0], ids[1]);
+    let independent =
+        !exe.references_var(recno) && !exe.references_var(outno) && !exe.has_late_constants();
+    Ok((exe, recno, outno, independent))
+}
+
 fn read_full(r: &mut dyn Read, buf: &mut [u8]) -> Result<usize> {
     let mut got = 0;
     while got < buf.len() {
@@ -753,7 +759,34 @@ fn read_full(r: &mut dyn Read, buf: &mut [u8]) -> Result<usize> {
 
 #[cfg(test)]
 mod tests {
-    use super::{atof, parse_plain};
+    use super::{atof, compile_program, parse_plain};
+
+    /// The programs of tests/rcalc.rs's thread test take the parallel path (so that test
+    /// compares two paths), and programs with record counters or late constants do not.
+    #[test]
+    fn independent_records_are_recognised() {
+        let lib = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("lib");
+        let cases: [(&[&str], bool); 6] = [
+            (&["MF:2;Dx=$1;Dy=$2;Dz=$3;$1=rbin;$2=1/$1;$3=in(0)"], true),
+            (&["$1=select($1,1,2);$2=$2;cond=$3+1"], true),
+            (&["$1=$1*$2+$3;$3=sqrt($2)"], true),
+            (&["$1=if($1-3.3333, f(1), $1)"], true),
+            (&["$1=recno"], false),
+            (&["first:$1;$1=$1-first"], false),
+        ];
+        for (k, (src, want)) in cases.into_iter().enumerate() {
+            let mut p = fenestra_calc::Program::for_rcalc();
+            if k == 0 {
+                // as the thread test's `-f reinhart.cal -e …`
+                p.load_file(&lib.join("reinhart.cal")).unwrap();
+            }
+            for e in src {
+                p.load_str("-e", e).unwrap();
+            }
+            let (_, _, _, independent) = compile_program(p).unwrap();
+            assert_eq!(independent, want, "{src:?}");
+        }
+    }
 
     #[test]
     fn plain_decimals_parse_as_str_parse_does() {
