@@ -34,11 +34,17 @@ impl Boundable for BoxPrim {
 pub struct Accel {
     /// The shapes, indexed as the caller gave them.
     pub shapes: Vec<Shape>,
-    bvh: Option<CwBvh>,
-    /// For a small scene: every shape's box, tested all at once.
-    flat: Option<Flat>,
+    index: Index,
     /// Largest absolute coordinate of the scene (for relative epsilons).
     pub scale: f64,
+}
+
+/// How rays find candidate shapes.
+enum Index {
+    /// A small scene: every shape's box, tested all at once.
+    Flat(Flat),
+    /// obvhs's BVH.
+    Bvh(CwBvh),
 }
 
 /// How far behind its origin a ray enters the BVH (more than obvhs's 1e-4 minimum box
@@ -133,35 +139,52 @@ impl Accel {
                 .max(hi.abs().max_element());
         }
         let pad = 2e-6 * scale;
-        let prims: Vec<BoxPrim> = bounds
-            .iter()
-            .map(|(lo, hi)| {
-                let lo = *lo - DVec3::splat(pad);
-                let hi = *hi + DVec3::splat(pad);
-                BoxPrim(Aabb::new(
-                    Vec3A::new(down(lo.x), down(lo.y), down(lo.z)),
-                    Vec3A::new(up(hi.x), up(hi.y), up(hi.z)),
-                ))
+        let index = if shapes.len() <= FLAT_MAX {
+            Index::Flat(Flat {
+                lo: [0, 1, 2].map(|a| bounds.iter().map(|(lo, _)| lo[a] - pad).collect()),
+                hi: [0, 1, 2].map(|a| bounds.iter().map(|(_, hi)| hi[a] + pad).collect()),
             })
-            .collect();
-        let small = shapes.len() <= FLAT_MAX;
-        let flat = small.then(|| Flat {
-            lo: [0, 1, 2].map(|a| bounds.iter().map(|(lo, _)| lo[a] - pad).collect()),
-            hi: [0, 1, 2].map(|a| bounds.iter().map(|(_, hi)| hi[a] + pad).collect()),
-        });
-        let bvh = (!small).then(|| {
-            obvhs::cwbvh::builder::build_cwbvh(
+        } else {
+            let prims: Vec<BoxPrim> = bounds
+                .iter()
+                .map(|(lo, hi)| {
+                    let lo = *lo - DVec3::splat(pad);
+                    let hi = *hi + DVec3::splat(pad);
+                    BoxPrim(Aabb::new(
+                        Vec3A::new(down(lo.x), down(lo.y), down(lo.z)),
+                        Vec3A::new(up(hi.x), up(hi.y), up(hi.z)),
+                    ))
+                })
+                .collect();
+            Index::Bvh(obvhs::cwbvh::builder::build_cwbvh(
                 &prims,
                 BvhBuildParams::medium_build(),
                 &mut std::time::Duration::default(),
-            )
-        });
+            ))
+        };
         Accel {
             shapes,
-            bvh,
-            flat,
+            index,
             scale,
         }
+    }
+
+    /// How far past distance `t` a shape's (padded) box may still be entered.
+    fn reach(&self, t: f64) -> f64 {
+        t * (1.0 + 1e-6) + 4e-6 * self.scale
+    }
+
+    /// Entry distances of every shape's box along a ray (the flat index), up to `tmax`;
+    /// returns the box limit used.
+    fn flat_entries(&self, flat: &Flat, org: DVec3, dir: DVec3, tmax: f64, ent: &mut [f64]) -> f64 {
+        let inv = DVec3::new(safe_inv(dir.x), safe_inv(dir.y), safe_inv(dir.z));
+        let box_max = if tmax.is_finite() {
+            self.reach(tmax)
+        } else {
+            f64::INFINITY
+        };
+        flat.entries(org, inv, box_max, ent);
+        box_max
     }
 
     /// The f32 ray the BVH is traversed with: started `BACK` behind `org`, since obvhs's
@@ -176,7 +199,7 @@ impl Accel {
             Vec3A::new(dir.x as f32 + 0.0, dir.y as f32 + 0.0, dir.z as f32 + 0.0),
             0.0,
             if tmax.is_finite() {
-                up(tmax * (1.0 + 1e-6) + 4e-6 * self.scale + BACK)
+                up(self.reach(tmax) + BACK)
             } else {
                 f32::INFINITY
             },
@@ -212,41 +235,32 @@ impl Accel {
                 }
             }
         };
-        match (&self.flat, &self.bvh) {
-            (Some(flat), _) => {
+        match &self.index {
+            Index::Flat(flat) => {
                 let mut ent = [0.0f64; FLAT_MAX];
                 let ent = &mut ent[..self.shapes.len()];
-                let inv = DVec3::new(safe_inv(dir.x), safe_inv(dir.y), safe_inv(dir.z));
-                let slack = 4e-6 * self.scale;
-                let box_max = if tmax.is_finite() {
-                    tmax * (1.0 + 1e-6) + slack
-                } else {
-                    f64::INFINITY
-                };
-                flat.entries(org, inv, box_max, ent);
-                let mut lim = box_max;
+                let mut lim = self.flat_entries(flat, org, dir, tmax, ent);
                 for (i, &e) in ent.iter().enumerate() {
                     if e <= lim && e < f64::INFINITY {
                         test(i, &mut best);
                         if let Some(b) = best {
-                            lim = b.t * (1.0 + 1e-6) + slack;
+                            lim = self.reach(b.t);
                         }
                     }
                 }
             }
-            (None, Some(bvh)) => {
+            Index::Bvh(bvh) => {
                 let ray = self.box_ray(org, dir, tmax);
                 let mut rh = obvhs::ray::RayHit::none();
                 bvh.ray_traverse(ray, &mut rh, |_r, id| {
                     let i = bvh.primitive_indices[id] as usize;
                     test(i, &mut best);
                     match best {
-                        Some(b) => up(b.t * (1.0 + 1e-6) + 4e-6 * self.scale + BACK),
+                        Some(b) => up(self.reach(b.t) + BACK),
                         None => f32::INFINITY,
                     }
                 });
             }
-            (None, None) => {}
         }
         best
     }
@@ -263,22 +277,16 @@ impl Accel {
     ) -> bool {
         let test =
             |i: usize| Some(i) != skip && self.shapes[i].intersect(org, dir, tmin, tmax).is_some();
-        match (&self.flat, &self.bvh) {
-            (Some(flat), _) => {
+        match &self.index {
+            Index::Flat(flat) => {
                 let mut ent = [0.0f64; FLAT_MAX];
                 let ent = &mut ent[..self.shapes.len()];
-                let inv = DVec3::new(safe_inv(dir.x), safe_inv(dir.y), safe_inv(dir.z));
-                let box_max = if tmax.is_finite() {
-                    tmax * (1.0 + 1e-6) + 4e-6 * self.scale
-                } else {
-                    f64::INFINITY
-                };
-                flat.entries(org, inv, box_max, ent);
+                self.flat_entries(flat, org, dir, tmax, ent);
                 ent.iter()
                     .enumerate()
                     .any(|(i, &e)| e < f64::INFINITY && test(i))
             }
-            (None, Some(bvh)) => {
+            Index::Bvh(bvh) => {
                 let ray = self.box_ray(org, dir, tmax);
                 !bvh.ray_traverse_miss(ray, |_r, id| {
                     if test(bvh.primitive_indices[id] as usize) {
@@ -288,7 +296,6 @@ impl Accel {
                     }
                 })
             }
-            (None, None) => false,
         }
     }
 
@@ -390,7 +397,7 @@ mod tests {
             ));
         }
         let acc = Accel::new(shapes.clone());
-        assert!(acc.flat.is_some());
+        assert!(matches!(acc.index, Index::Flat(_)));
         let mut rng = crate::rng::Rng::for_ray(11, 3);
         let mut hits = 0;
         for k in 0..4000 {
@@ -451,7 +458,7 @@ mod tests {
                 ));
             }
             let acc = Accel::new(shapes);
-            assert_eq!(acc.flat.is_some(), extra == 0);
+            assert_eq!(matches!(acc.index, Index::Flat(_)), extra == 0);
             let org = DVec3::new(3.5e-6, 0.44, 3.0);
             let dir = DVec3::new(-0.875, 0.171, -0.4525).normalize();
             let h = acc.closest(org, dir, 4e-9, f64::INFINITY, None).unwrap();
