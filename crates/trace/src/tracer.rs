@@ -1644,6 +1644,12 @@ impl Tracer {
         // Directions are drawn a batch at a time (stratum by stratum, row-major), then
         // traced: the batch's arithmetic runs without waiting on each ray's tracing.
         let nf = n as f64;
+        // a jittered direction in stratum (row i, column j)
+        let stratum = |i: usize, j: usize, cx: &mut Ctx| {
+            let x = (j as f64 + cx.rng.next_f64()) / nf;
+            let y = (i as f64 + cx.rng.next_f64()) / nf;
+            direction(x, y)
+        };
         let total = n * n;
         // -as: extra samples where the neighbouring strata vary most (Radiance's rtrace does
         // it for hemispheres of more than 4×4 strata and more than 8 extra samples)
@@ -1656,14 +1662,12 @@ impl Tracer {
         while done < total {
             let m = (total - done).min(AMB_BATCH);
             for d in dirs.iter_mut().take(m) {
-                let x = (j as f64 + cx.rng.next_f64()) / nf;
-                let y = (i as f64 + cx.rng.next_f64()) / nf;
+                *d = stratum(i, j, cx);
                 j += 1;
                 if j == n {
                     j = 0;
                     i += 1;
                 }
-                *d = direction(x, y);
             }
             for &dir in &dirs[..m] {
                 let v = shoot(dir, acoef, cx);
@@ -1676,9 +1680,7 @@ impl Tracer {
         }
         if keep {
             sum = super_sample(&mut vals, n, extra, cx, |i, j, cx| {
-                let x = (j as f64 + cx.rng.next_f64()) / nf;
-                let y = (i as f64 + cx.rng.next_f64()) / nf;
-                shoot(direction(x, y), acoef, cx)
+                shoot(stratum(i, j, cx), acoef, cx)
             });
         }
         sum
