@@ -9,6 +9,7 @@ use std::path::Path;
 use std::process::ExitCode;
 
 use anyhow::{anyhow, bail, Result};
+use fenestra_bsdf::check::sampled::SampledRow;
 use fenestra_bsdf::check::{self, ComponentCheck, Reciprocity};
 use fenestra_bsdf::{BlockData, Bsdf, Direction, Wavelength};
 use fenestra_cli::opts::{Item, Spec};
@@ -26,7 +27,7 @@ fn spec() -> Spec {
 /// Monte Carlo BSDFs (genBSDF) carry noise of this order.
 const ENERGY_NOISE: f64 = 0.01;
 
-/// Tree reciprocity rows: largest spread of pair errors (a fraction) for which the grid is
+/// Coloured tree reciprocity rows: largest spread of pair errors (a fraction) for which the grid is
 /// finished; beyond it min and max cannot print the same.
 const SPREAD: f64 = 0.001;
 
@@ -51,7 +52,10 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         let path = fenestra_cli::raypath::find(f).unwrap_or_else(|| Path::new(f).into());
         let b = fenestra_bsdf::read_file(&path).map_err(|e| anyhow!("{e}"))?;
         let colour = fenestra_bsdf::radiance::colour_lambertians(&b, &mut rng);
-        let text = report(f, &b, &colour)?;
+        let xml = std::fs::read_to_string(&path).map_err(|e| anyhow!("{}: {e}", path.display()))?;
+        let sampled = check::sampled::tree_rows(&xml, &b, &mut rng)
+            .map_err(|e| anyhow!("{}: {e}", path.display()))?;
+        let text = report(f, &b, &colour, sampled)?;
         out.write_all(text.as_bytes())?;
         out.flush()?;
     }
@@ -96,28 +100,15 @@ fn angle(a: f64) -> String {
     }
 }
 
-/// The report for one file (`colour`: the coloured Lambertian parts split off on loading).
-fn report(name: &str, b: &Bsdf, colour: &[(Direction, [f64; 3])]) -> Result<String> {
+/// The report for one file (`colour`: the coloured Lambertian parts split off on loading;
+/// `sampled`: the reciprocity rows of a grey tensor-tree file, from `check::sampled`).
+fn report(
+    name: &str,
+    b: &Bsdf,
+    colour: &[(Direction, [f64; 3])],
+    sampled: Option<[SampledRow; 3]>,
+) -> Result<String> {
     let mut s = String::new();
-    s.push_str("=====================================================\n");
-    writeln!(s, "File: '{name}'")?;
-    writeln!(s, "Manufacturer: '{}'", b.manufacturer)?;
-    writeln!(s, "BSDF Name: '{}'", b.name)?;
-    let cm = |v: Option<f64>| g(v.unwrap_or(0.0) * 100.0, 6);
-    writeln!(
-        s,
-        "Dimensions (W x H x Thickness): {} x {} x {} cm",
-        cm(b.width),
-        cm(b.height),
-        cm(b.thickness)
-    )?;
-    writeln!(s, "Type: {}", data_type(b))?;
-    writeln!(s, "Color: {}", u8::from(b.has_colour()))?;
-    let geom = b
-        .geometry
-        .as_ref()
-        .is_some_and(|g| !g.mgf.trim().is_empty());
-    writeln!(s, "Has Geometry: {}", u8::from(geom))?;
     let tree = b
         .blocks
         .iter()
@@ -137,6 +128,36 @@ fn report(name: &str, b: &Bsdf, colour: &[(Direction, [f64; 3])]) -> Result<Stri
         comp(Direction::TransmissionBack),
         comp(Direction::TransmissionFront),
     );
+    // Radiance drops a tree component whose largest directional total, its Lambertian part
+    // removed, is at most 0.001; the split-off part still prints (as a missing transmission's).
+    let dropped = |c: &ComponentCheck| tree && c.max_total - c.lambertian_xyz[1] <= 0.001;
+    let all_dropped = [&rf, &rb, &tf, &tb]
+        .iter()
+        .all(|c| c.as_ref().is_none_or(dropped));
+    s.push_str("=====================================================\n");
+    writeln!(s, "File: '{name}'")?;
+    writeln!(s, "Manufacturer: '{}'", b.manufacturer)?;
+    writeln!(s, "BSDF Name: '{}'", b.name)?;
+    let cm = |v: Option<f64>| g(v.unwrap_or(0.0) * 100.0, 6);
+    writeln!(
+        s,
+        "Dimensions (W x H x Thickness): {} x {} x {} cm",
+        cm(b.width),
+        cm(b.height),
+        cm(b.thickness)
+    )?;
+    let kind = if tree && all_dropped {
+        "Pure_Lambertian".to_string()
+    } else {
+        data_type(b)
+    };
+    writeln!(s, "Type: {kind}")?;
+    writeln!(s, "Color: {}", u8::from(b.has_colour()))?;
+    let geom = b
+        .geometry
+        .as_ref()
+        .is_some_and(|g| !g.mgf.trim().is_empty());
+    writeln!(s, "Has Geometry: {}", u8::from(geom))?;
     s.push_str("Component\tLambertian XYZ (%)\tMax. Tot. Dir\tMin. Angle\n");
     // one component row: Lambertian XYZ, largest directional total, smallest angle
     let line = |s: &mut String, label: &str, l: [f64; 3], m: f64, a: f64| {
@@ -151,6 +172,13 @@ fn report(name: &str, b: &Bsdf, colour: &[(Direction, [f64; 3])]) -> Result<Stri
         );
     };
     let row = |s: &mut String, label: &str, c: &Option<ComponentCheck>| match c {
+        Some(c) if dropped(c) => line(
+            s,
+            label,
+            c.lambertian_xyz,
+            c.lambertian_xyz[1] / 100.0,
+            180.0,
+        ),
         Some(c) => line(s, label, c.lambertian_xyz, c.max_total, c.min_angle_deg),
         None => line(s, label, [0.0; 3], 0.0, 180.0),
     };
@@ -188,10 +216,23 @@ fn report(name: &str, b: &Bsdf, colour: &[(Direction, [f64; 3])]) -> Result<Stri
             None => writeln!(s, "{label}\t  0\t  0\t  0"),
         };
     };
-    if tree {
-        // Radiance samples tree pairs at random; the rows are printed only where the sampling
-        // cannot change them (every pair's error the same to the printed precision). The grid
-        // is abandoned once two errors differ by more than 0.1%.
+    if let Some(rows) = sampled {
+        // Grey tensor trees: Radiance's sampled rows, reproduced (check::sampled).
+        for (label, r) in ["Interior Refl", "Exterior Refl", "Transmission"]
+            .into_iter()
+            .zip(rows)
+        {
+            match r {
+                SampledRow::Values(r) => rec(&mut s, label, Some(r)),
+                SampledRow::Absent => rec(&mut s, label, None),
+                SampledRow::Dropped => {}
+            }
+        }
+    } else if tree {
+        // Coloured tensor trees (CIE-u/v blocks): Radiance's sampling is not reproduced for
+        // them; a row is printed only where no sampling can change it (every pair's error the
+        // same to the printed precision on the finest grid, abandoned once two errors differ
+        // by more than 0.1%).
         let trec = |s: &mut String, label: &str, r: Option<Option<Reciprocity>>| match r {
             Some(Some(r))
                 if format!("{:5.1}", 100.0 * r.min) == format!("{:5.1}", 100.0 * r.max) =>

@@ -10,6 +10,7 @@
 //! reflection and `f'` = the opposite transmission block; min, mean and max are over all element
 //! pairs without a zero element.
 
+pub mod sampled;
 pub mod tree;
 
 use crate::klems::KlemsBasis;

@@ -1,0 +1,796 @@
+//! Reciprocity rows of tensor-tree files computed the way Radiance 6.0a's `checkBSDF` samples
+//! them, so that the printed rows agree digit for digit (docs/tools/checkBSDF.md).
+//!
+//! Radiance compares, for pairs of directions `(a, b)`, the total BSDF (Lambertian part
+//! included) for light from `b` towards `a` with the one for light from `a` towards `b`, as the
+//! relative difference `|x − y| / (max(x, y) + 1e-6)`; no pair is left out, a zero against a
+//! value gives 100%. The pairs come from a random quadtree over the unit square that the
+//! Shirley–Chiu map sends to the hemisphere:
+//!
+//! * The square is split into 16 × 16 cells, then each cell (visited in quadrant order: left
+//!   top, right top, left bottom, right bottom) draws a point with two `drand48()` numbers. When
+//!   the tree leaf that holds the pair at that point is smaller than the cell (projected solid
+//!   angle `π·leaf²` below `π·cell² − 1e-6`) the point is dropped and the cell is split in
+//!   four, each drawing its own point; otherwise the point is one sample.
+//! * Rank 3 (isotropic): the first direction walks the radius `(k + ½)·s` along +x (`s` = the
+//!   forward component's smallest leaf), the second comes from the quadtree over the other
+//!   hemisphere side (`Transmission Back` is the forward transmission).
+//! * Rank 4: the first direction comes from a quadtree of its own, where a cell's size is
+//!   compared with the smallest leaf that the tree slice of that incident direction holds; each
+//!   accepted point runs a second quadtree for the other direction.
+//!
+//! Tree values are looked up as Radiance does: nearest leaf, after the Lambertian minimum is
+//! subtracted (float arithmetic), times Radiance's position-dependent factor `1 + 1e-4·d` that
+//! keeps equal leaves apart. The generator is the process's one (the colour dither's): state
+//! runs on from file to file.
+
+use std::f64::consts::{FRAC_PI_4, PI};
+
+use crate::check::Reciprocity;
+use crate::model::{Bsdf, Direction};
+use crate::radiance::Drand48;
+
+/// Radiance's `FTINY`.
+const FTINY: f64 = 1e-6;
+
+/// Which side of the surface a tree describes (Radiance's front = XML back).
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Side {
+    /// XML `Reflection Back`.
+    FrontRefl,
+    /// XML `Reflection Front`.
+    BackRefl,
+    /// XML `Transmission Back`.
+    FrontTrans,
+    /// XML `Transmission Front`.
+    BackTrans,
+}
+
+#[derive(Debug)]
+enum Node {
+    Branch(Vec<Node>),
+    Grid { log2: u32, values: Vec<f32> },
+}
+
+/// One `Visible` tree as Radiance holds it after loading (Lambertian minimum subtracted).
+#[derive(Debug)]
+struct Tree {
+    rank: usize,
+    side: Side,
+    root: Node,
+}
+
+/// A leaf found by a lookup: its value and its hypercube (lower corner, edge).
+struct Leaf {
+    value: f32,
+    corner: [f64; 4],
+    edge: f64,
+}
+
+impl Tree {
+    fn lookup(&self, pos: &[f64; 4]) -> Leaf {
+        let r = self.rank;
+        let mut p = *pos;
+        let mut corner = [0.0; 4];
+        let mut edge = 1.0;
+        let mut node = &self.root;
+        loop {
+            match node {
+                Node::Branch(ch) => {
+                    edge *= 0.5;
+                    let mut n = 0;
+                    for i in (0..r).rev() {
+                        let s = 2.0 * p[i];
+                        let t = usize::from(s >= 1.0);
+                        n |= t << i;
+                        p[i] = s - t as f64;
+                        corner[i] += t as f64 * edge;
+                    }
+                    node = &ch[n];
+                }
+                Node::Grid { log2, values } => {
+                    if *log2 == 0 {
+                        return Leaf {
+                            value: values[0],
+                            corner,
+                            edge,
+                        };
+                    }
+                    let cells = (1u64 << log2) as f64;
+                    let top = (1usize << log2) - 1;
+                    let mut n = 0usize;
+                    for v in &p[..r] {
+                        n = (n << log2) + ((cells * v) as usize).min(top);
+                    }
+                    edge /= cells;
+                    for i in (0..r).rev() {
+                        corner[i] += (cells * p[i]).floor().min(top as f64) * edge;
+                    }
+                    return Leaf {
+                        value: values[n],
+                        corner,
+                        edge,
+                    };
+                }
+            }
+        }
+    }
+
+    /// Edge of the smallest leaf.
+    fn smallest_leaf(&self) -> f64 {
+        fn walk(n: &Node) -> f64 {
+            match n {
+                Node::Branch(ch) => 0.5 * ch.iter().map(walk).fold(1.0, f64::min),
+                Node::Grid { log2, .. } => 1.0 / (1u64 << log2) as f64,
+            }
+        }
+        walk(&self.root)
+    }
+
+    /// Edge of the smallest leaf met by the slice through `pos` in the dimensions of `mask`.
+    fn slice_smallest_leaf(&self, pos: &[f64; 4], mask: u32) -> f64 {
+        fn walk(n: &Node, pos: &[f64; 4], mask: u32, rank: usize, lo: &[f64; 4], size: f64) -> f64 {
+            match n {
+                Node::Branch(ch) => {
+                    let half = 0.5 * size;
+                    let mut best = f64::INFINITY;
+                    'child: for (k, c) in ch.iter().enumerate() {
+                        let mut clo = *lo;
+                        for i in 0..rank {
+                            let upper = k >> i & 1 == 1;
+                            if mask >> i & 1 == 1 && (pos[i] >= lo[i] + half) != upper {
+                                continue 'child;
+                            }
+                            if upper {
+                                clo[i] += half;
+                            }
+                        }
+                        best = best.min(walk(c, pos, mask, rank, &clo, half));
+                    }
+                    best
+                }
+                Node::Grid { log2, .. } => size / (1u64 << log2) as f64,
+            }
+        }
+        walk(&self.root, pos, mask, self.rank, &[0.0; 4], 1.0)
+    }
+
+    /// Smallest value Radiance considers for the Lambertian part (rank 3: only the half of the
+    /// incident coordinate that directions reach).
+    fn lambertian_min(&self) -> f32 {
+        fn min_of(n: &Node) -> f32 {
+            match n {
+                Node::Branch(ch) => ch.iter().map(min_of).fold(f32::INFINITY, f32::min),
+                Node::Grid { values, .. } => values.iter().copied().fold(f32::INFINITY, f32::min),
+            }
+        }
+        if self.rank != 3 {
+            return min_of(&self.root);
+        }
+        let cap = (1.5 / PI) as f32;
+        match &self.root {
+            Node::Branch(ch) => ch.iter().step_by(2).map(min_of).fold(cap, f32::min),
+            Node::Grid { log2: 0, values } => values[0],
+            Node::Grid { log2, values } => values[..1usize << (3 * log2 - 1)]
+                .iter()
+                .copied()
+                .fold(cap, f32::min),
+        }
+    }
+
+    fn subtract(&mut self, v: f32) {
+        fn walk(n: &mut Node, v: f32) {
+            match n {
+                Node::Branch(ch) => ch.iter_mut().for_each(|c| walk(c, v)),
+                Node::Grid { values, .. } => {
+                    for x in values {
+                        *x = (*x - v).max(0.0);
+                    }
+                }
+            }
+        }
+        walk(&mut self.root, v)
+    }
+
+    /// Splits the Lambertian part off as Radiance does on loading; returns it as a
+    /// hemispherical fraction (π × minimum; 0 when nothing is split off).
+    fn split_lambertian(&mut self) -> f64 {
+        let vmin = self.lambertian_min();
+        if vmin >= (1.5 / PI) as f32 || f64::from(vmin) <= 0.01 / PI {
+            return 0.0;
+        }
+        self.subtract(vmin);
+        PI * f64::from(vmin)
+    }
+
+    /// Orders a direction pair for this tree (`a` where light comes from as Radiance's tree
+    /// query names it); `None` when the pair is not on this component's sides.
+    fn orient(&self, a: [f64; 3], b: [f64; 3]) -> Option<([f64; 3], [f64; 3])> {
+        match self.side {
+            Side::FrontRefl => (b[2] >= 0.0 && a[2] >= 0.0).then_some((a, b)),
+            Side::BackRefl => (b[2] <= 0.0 && a[2] <= 0.0).then_some((a, b)),
+            Side::FrontTrans => {
+                if b[2] > 0.0 {
+                    (a[2] <= 0.0).then_some((b, a))
+                } else {
+                    (a[2] >= 0.0).then_some((a, b))
+                }
+            }
+            Side::BackTrans => {
+                if a[2] > 0.0 {
+                    (b[2] <= 0.0).then_some((b, a))
+                } else {
+                    (b[2] >= 0.0).then_some((a, b))
+                }
+            }
+        }
+    }
+
+    /// The leaf for the pair `(a, b)` in Radiance's tree-query order.
+    fn query(&self, a: [f64; 3], b: [f64; 3]) -> Option<Leaf> {
+        let (i, o) = self.orient(a, b)?;
+        let mut pos = [0.0; 4];
+        if self.rank == 3 {
+            let theta = -(-i[1]).atan2(-i[0]);
+            let r = spin_z(o, theta);
+            pos[0] = (0.5 - FTINY) - 0.5 * (i[0] * i[0] + i[1] * i[1]).sqrt();
+            let (u, v) = disk_to_square(r[0], r[1]);
+            pos[1] = u;
+            pos[2] = v;
+        } else {
+            let (u, v) = disk_to_square(-i[0], -i[1]);
+            let (s, t) = disk_to_square(o[0], o[1]);
+            pos = [u, v, s, t];
+        }
+        Some(self.lookup(&pos))
+    }
+
+    /// The tree's BSDF value for the pair as Radiance returns it (float, with its
+    /// position-dependent factor).
+    fn value(&self, a: [f64; 3], b: [f64; 3]) -> Option<f32> {
+        let leaf = self.query(a, b)?;
+        let mut d = 0.0;
+        for i in (0..self.rank).rev() {
+            let x = f64::from(2u32 << i) / (leaf.corner[i] + 0.01687);
+            d += x - x.trunc() - 0.5;
+        }
+        Some((f64::from(leaf.value) * (1.0 + 1e-4 * d)) as f32)
+    }
+
+    /// Projected solid angle of the leaf for a pair (`π·edge²`), or, without `b`, of the
+    /// smallest leaf in the slice of incident direction `a`.
+    fn proj_sa(&self, a: [f64; 3], b: Option<[f64; 3]>) -> Option<f64> {
+        match b {
+            Some(b) => {
+                let e = self.query(a, b)?.edge;
+                Some(e * (e * PI))
+            }
+            None => {
+                if self.rank != 4 {
+                    return None;
+                }
+                // Radiance's cumulative distribution for incident direction a: a tree used in
+                // reverse (light arriving on the other side) slices its outgoing dimensions.
+                let front = a[2] > 0.0;
+                let reverse = match self.side {
+                    Side::FrontRefl => {
+                        if !front {
+                            return Some(0.0);
+                        }
+                        false
+                    }
+                    Side::BackRefl => {
+                        if a[2] > 0.0 {
+                            return Some(0.0);
+                        }
+                        false
+                    }
+                    Side::FrontTrans => a[2] < 0.0,
+                    Side::BackTrans => a[2] > 0.0,
+                };
+                let (u, v) = if reverse {
+                    disk_to_square(a[0], a[1])
+                } else {
+                    disk_to_square(-a[0], -a[1])
+                };
+                if !(0.0..1.0).contains(&u) || !(0.0..1.0).contains(&v) {
+                    return Some(0.0);
+                }
+                let (pos, mask) = if reverse {
+                    ([0.0, 0.0, u, v], 0b1100)
+                } else {
+                    ([u, v, 0.0, 0.0], 0b0011)
+                };
+                let w = self.slice_smallest_leaf(&pos, mask);
+                let wid = (w * 65536.0 + 0.5) as u32;
+                let s = f64::from(wid) / 65536.0;
+                Some(PI * s * s)
+            }
+        }
+    }
+}
+
+/// Rotation about z by `theta` (Radiance's `spinvector` with the z axis).
+fn spin_z(v: [f64; 3], theta: f64) -> [f64; 3] {
+    if theta == 0.0 {
+        return v;
+    }
+    let (s, c) = theta.sin_cos();
+    [v[0] * c - v[1] * s, v[1] * c + v[0] * s, v[2]]
+}
+
+/// Shirley–Chiu disk → square, as Radiance computes it.
+fn disk_to_square(x: f64, y: f64) -> (f64, f64) {
+    crate::tree::disk_to_square(x, y)
+}
+
+/// Shirley–Chiu square → disk, as Radiance computes it.
+fn square_to_disk(u: f64, v: f64) -> (f64, f64) {
+    let a = 2.0 * u - 1.0;
+    let b = 2.0 * v - 1.0;
+    let (r, phi) = if a > -b {
+        if a > b {
+            (a, FRAC_PI_4 * (b / a))
+        } else {
+            (b, FRAC_PI_4 * (2.0 - a / b))
+        }
+    } else if a < b {
+        (-a, FRAC_PI_4 * (4.0 + b / a))
+    } else {
+        (
+            -b,
+            if b != 0.0 {
+                FRAC_PI_4 * (6.0 - a / b)
+            } else {
+                0.0
+            },
+        )
+    };
+    let r = r * 0.9999999999999;
+    (r * phi.cos(), r * phi.sin())
+}
+
+/// The loaded file as far as the reciprocity check needs it.
+struct Loaded {
+    rank: usize,
+    /// Radiance's rf, rb, tf, tb.
+    rf: Option<Tree>,
+    rb: Option<Tree>,
+    tf: Option<Tree>,
+    tb: Option<Tree>,
+    /// Lambertian parts (hemispherical fractions): rf, rb, tf, tb sides.
+    r_lamb_front: f64,
+    r_lamb_back: f64,
+    t_lamb_front: f64,
+    t_lamb_back: f64,
+}
+
+/// Outcome of one row.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SampledRow {
+    /// min, mean, max over the sampled pairs.
+    Values(Reciprocity),
+    /// No component (Radiance prints `0 0 0`).
+    Absent,
+    /// Radiance stops the row without printing it (a sample fell on the disk's rim).
+    Dropped,
+}
+
+struct Stats {
+    lo: f64,
+    hi: f64,
+    sum: f64,
+    n: u64,
+}
+
+impl Loaded {
+    /// Total BSDF (Y, sr⁻¹) for light arriving from `inc` and leaving towards `out`.
+    fn eval(&self, out: [f64; 3], inc: [f64; 3]) -> f64 {
+        let (fi, fo) = (inc[2] > 0.0, out[2] > 0.0);
+        let (lamb, tree) = if fi && fo {
+            (self.r_lamb_front, self.rf.as_ref())
+        } else if !fi && !fo {
+            (self.r_lamb_back, self.rb.as_ref())
+        } else if fi {
+            (self.t_lamb_front, self.tf.as_ref().or(self.tb.as_ref()))
+        } else {
+            (self.t_lamb_back, self.tb.as_ref().or(self.tf.as_ref()))
+        };
+        let mut y = lamb * (1.0 / PI);
+        if let Some(v) = tree.and_then(|t| t.value(out, inc)) {
+            y += f64::from(v);
+        }
+        y
+    }
+
+    /// Radiance's smallest projected solid angle for sample `v1` (and `v2`); `None` when a
+    /// tree refuses the pair (Radiance reports an internal error and stops the row).
+    fn size(&self, v1: [f64; 3], v2: Option<[f64; 3]>) -> Option<f64> {
+        let front = v1[2] > 0.0;
+        let (mut r, mut t) = if front {
+            (self.rf.as_ref(), self.tf.as_ref().or(self.tb.as_ref()))
+        } else {
+            (self.rb.as_ref(), self.tb.as_ref().or(self.tf.as_ref()))
+        };
+        if let Some(v2) = v2 {
+            if front != (v2[2] > 0.0) {
+                r = None;
+            } else {
+                t = None;
+            }
+        }
+        let mut psa: f64 = 10.0;
+        let mut any = false;
+        for tree in [r, t].into_iter().flatten() {
+            let p = tree.proj_sa(v1, v2)?;
+            any = true;
+            if p > 0.0 && p < psa {
+                psa = p;
+            }
+        }
+        Some(if any { psa } else { PI })
+    }
+
+    /// One quadtree over a hemisphere (`side` ±1) with first direction `v0`, calling `cf` for
+    /// every accepted sample; `false` stops everything (as Radiance's `&&` chain does).
+    fn quadtree(
+        &self,
+        rng: &mut Drand48,
+        cell: (f64, f64, f64),
+        side: f64,
+        v0: Option<[f64; 3]>,
+        cf: &mut dyn FnMut(&Self, &mut Drand48, [f64; 3]) -> bool,
+    ) -> bool {
+        let (x, y, siz) = cell;
+        if siz < 0.124 {
+            // Radiance's build evaluates the two arguments right to left: y draws first.
+            let ry = rng.next_f64();
+            let rx = rng.next_f64();
+            let (dx, dy) = square_to_disk(x + rx * siz, y + ry * siz);
+            let z = 1.0 - dx * dx - dy * dy;
+            if z <= 0.0 {
+                return false;
+            }
+            let v = [dx, dy, side * z.sqrt()];
+            let Some(sa) = self.size(v, v0) else {
+                return false;
+            };
+            if sa >= PI * siz * siz - FTINY {
+                return cf(self, rng, v);
+            }
+        }
+        let h = siz * 0.5;
+        self.quadtree(rng, (x, y, h), side, v0, cf)
+            && self.quadtree(rng, (x + h, y, h), side, v0, cf)
+            && self.quadtree(rng, (x, y + h, h), side, v0, cf)
+            && self.quadtree(rng, (x + h, y + h, h), side, v0, cf)
+    }
+
+    fn pair(&self, st: &mut Stats, v1: [f64; 3], v0: [f64; 3]) {
+        let other = self.eval(v0, v1);
+        let y = self.eval(v1, v0);
+        let e = if y > other {
+            (y - other) / (y + FTINY)
+        } else {
+            (other - y) / (other + FTINY)
+        };
+        st.lo = st.lo.min(e);
+        st.hi = st.hi.max(e);
+        st.sum += e;
+        st.n += 1;
+    }
+
+    fn row(&self, rng: &mut Drand48, side1: f64, side2: f64) -> SampledRow {
+        let df = if side1 == side2 {
+            if side1 > 0.0 {
+                self.rf.as_ref()
+            } else {
+                self.rb.as_ref()
+            }
+        } else if self.tf.is_none() || self.tb.is_none() {
+            None
+        } else {
+            self.tf.as_ref()
+        };
+        let Some(df) = df else {
+            return SampledRow::Absent;
+        };
+        let mut st = Stats {
+            lo: 1e10,
+            hi: -1e10,
+            sum: 0.0,
+            n: 0,
+        };
+        let ok = if self.rank == 3 {
+            let w = df.smallest_leaf();
+            let step = ((PI * w * w) / PI).sqrt();
+            let mut x = 0.5 * step;
+            let mut ok = true;
+            while x < 1.0 {
+                let vin = [x, 0.0, side1 * (1.0 - x * x).sqrt()];
+                let mut cf = |l: &Self, _: &mut Drand48, v: [f64; 3]| {
+                    l.pair(&mut st, v, vin);
+                    true
+                };
+                if !self.quadtree(rng, (0.0, 0.0, 1.0), side2, Some(vin), &mut cf) {
+                    ok = false;
+                    break;
+                }
+                x += step;
+            }
+            ok
+        } else {
+            let reflect = side1 == side2;
+            let mut outer = |l: &Self, rng: &mut Drand48, v1: [f64; 3]| {
+                let below = v1[2] < 0.0;
+                let side = if reflect == below { -1.0 } else { 1.0 };
+                let mut cf = |l: &Self, _: &mut Drand48, v: [f64; 3]| {
+                    l.pair(&mut st, v, v1);
+                    true
+                };
+                l.quadtree(rng, (0.0, 0.0, 1.0), side, Some(v1), &mut cf)
+            };
+            self.quadtree(rng, (0.0, 0.0, 1.0), side1, None, &mut outer)
+        };
+        if !ok {
+            return SampledRow::Dropped;
+        }
+        if st.n == 0 {
+            return SampledRow::Absent;
+        }
+        SampledRow::Values(Reciprocity {
+            min: st.lo,
+            mean: st.sum / st.n as f64,
+            max: st.hi,
+        })
+    }
+}
+
+/// Parses one `ScatteringData` tree as Radiance loads it (negative values read as 0).
+fn parse_tree(rank: usize, text: &str) -> Result<Node, String> {
+    let s = text.as_bytes();
+    let mut i = 0usize;
+    fn skip(s: &[u8], i: &mut usize) {
+        while *i < s.len() && (s[*i].is_ascii_whitespace() || s[*i] == b',') {
+            *i += 1;
+        }
+    }
+    fn node(s: &[u8], i: &mut usize, rank: usize) -> Result<Node, String> {
+        skip(s, i);
+        if s.get(*i) != Some(&b'{') {
+            return Err(format!("expected '{{' at byte {i}"));
+        }
+        *i += 1;
+        skip(s, i);
+        if s.get(*i) == Some(&b'{') {
+            let mut ch = Vec::with_capacity(1 << rank);
+            for _ in 0..1 << rank {
+                ch.push(node(s, i, rank)?);
+            }
+            skip(s, i);
+            if s.get(*i) != Some(&b'}') {
+                return Err(format!("expected '}}' at byte {i}"));
+            }
+            *i += 1;
+            return Ok(Node::Branch(ch));
+        }
+        let mut values = Vec::new();
+        loop {
+            skip(s, i);
+            match s.get(*i) {
+                Some(b'}') => {
+                    *i += 1;
+                    break;
+                }
+                None => return Err("unexpected end of tree data".into()),
+                _ => {}
+            }
+            let start = *i;
+            while *i < s.len()
+                && !matches!(s[*i], b'}' | b'{' | b',')
+                && !s[*i].is_ascii_whitespace()
+            {
+                *i += 1;
+            }
+            let tok = std::str::from_utf8(&s[start..*i]).unwrap_or("?");
+            let v: f64 = tok
+                .parse()
+                .map_err(|_| format!("bad number '{tok}' at byte {start}"))?;
+            values.push((v as f32).max(0.0));
+        }
+        let mut log2 = 0u32;
+        let mut k = 1usize;
+        while k < values.len() {
+            k <<= rank;
+            log2 += 1;
+        }
+        if k != values.len() {
+            return Err(format!(
+                "illegal value count {} in a tree leaf",
+                values.len()
+            ));
+        }
+        Ok(Node::Grid { log2, values })
+    }
+    let root = node(s, &mut i, rank)?;
+    skip(s, &mut i);
+    if i < s.len() {
+        return Err(format!("extra characters after the tree at byte {i}"));
+    }
+    Ok(root)
+}
+
+/// Radiance's three reciprocity rows (Interior Refl, Exterior Refl, Transmission) for a
+/// grey tensor-tree file, drawing from `rng`. `xml` is the file's text, `b` the same file read
+/// (for the components Radiance drops as insignificant). `Ok(None)` for files this does not
+/// cover (Klems matrices, coloured trees: CIE-u/v blocks).
+pub fn tree_rows(
+    xml: &str,
+    b: &Bsdf,
+    rng: &mut Drand48,
+) -> Result<Option<[SampledRow; 3]>, String> {
+    let root = crate::dom::parse(xml).map_err(|(m, p)| format!("{m} (byte {p})"))?;
+    let Some(layer) = root.child("Optical").and_then(|o| o.child("Layer")) else {
+        return Ok(None);
+    };
+    let rank = match layer
+        .child("DataDefinition")
+        .and_then(|d| d.child_text("IncidentDataStructure"))
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
+        Some("tensortree3") => 3,
+        Some("tensortree4") => 4,
+        _ => return Ok(None),
+    };
+    let mut trees: [Option<Tree>; 4] = [None, None, None, None];
+    for wd in layer.children_named("WavelengthData") {
+        let wl = wd
+            .child_text("Wavelength")
+            .unwrap_or("")
+            .to_ascii_lowercase();
+        if wl == "cie-u" || wl == "cie-v" {
+            return Ok(None);
+        }
+        if wl != "visible" {
+            continue;
+        }
+        for blk in wd.children_named("WavelengthDataBlock") {
+            let Some(d) = blk
+                .child_text("WavelengthDataDirection")
+                .and_then(Direction::parse)
+            else {
+                continue;
+            };
+            let text = blk.child("ScatteringData").map_or("", |e| e.text.as_str());
+            let node = parse_tree(rank, text).map_err(|e| format!("{}: {e}", d.xml_name()))?;
+            let (k, side) = match d {
+                Direction::ReflectionBack => (0, Side::FrontRefl),
+                Direction::ReflectionFront => (1, Side::BackRefl),
+                Direction::TransmissionBack => (2, Side::FrontTrans),
+                Direction::TransmissionFront => (3, Side::BackTrans),
+            };
+            trees[k] = Some(Tree {
+                rank,
+                side,
+                root: node,
+            });
+        }
+    }
+    let [mut rf, mut rb, mut tf, mut tb] = trees;
+    let lamb = |t: &mut Option<Tree>| t.as_mut().map_or(0.0, Tree::split_lambertian);
+    let r_lamb_front = lamb(&mut rf);
+    let r_lamb_back = lamb(&mut rb);
+    let mut t_lamb_front = lamb(&mut tf);
+    let mut t_lamb_back = 0.0;
+    if tb.is_some() {
+        t_lamb_back = lamb(&mut tb);
+        if tf.is_none() {
+            t_lamb_front = t_lamb_back;
+        }
+    } else if tf.is_some() {
+        t_lamb_back = t_lamb_front;
+    }
+    // Radiance drops components whose largest directional total (Lambertian part removed) is
+    // at most 0.001.
+    let keep = |t: Option<Tree>, d: Direction, l: f64| {
+        t.filter(|_| crate::check::tree_component(b, d).is_some_and(|c| c.max_total - l > 0.001))
+    };
+    let loaded = Loaded {
+        rank,
+        rf: keep(rf, Direction::ReflectionBack, r_lamb_front),
+        rb: keep(rb, Direction::ReflectionFront, r_lamb_back),
+        tf: keep(tf, Direction::TransmissionBack, t_lamb_front),
+        tb: keep(tb, Direction::TransmissionFront, t_lamb_back),
+        r_lamb_front,
+        r_lamb_back,
+        t_lamb_front,
+        t_lamb_back,
+    };
+    Ok(Some([
+        loaded.row(rng, 1.0, 1.0),
+        loaded.row(rng, -1.0, -1.0),
+        loaded.row(rng, -1.0, 1.0),
+    ]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A rank-3 grey file holding one `Reflection Back` tree.
+    fn refl_file(tree: &str) -> String {
+        format!(
+            "<WindowElement><Optical><Layer><DataDefinition>\
+             <IncidentDataStructure>TensorTree3</IncidentDataStructure></DataDefinition>\
+             <WavelengthData><Wavelength>Visible</Wavelength><WavelengthDataBlock>\
+             <WavelengthDataDirection>Reflection Back</WavelengthDataDirection>\
+             <ScatteringData>{tree}</ScatteringData></WavelengthDataBlock></WavelengthData>\
+             </Layer></Optical></WindowElement>"
+        )
+    }
+
+    fn rows(xml: &str, rng: &mut Drand48) -> [SampledRow; 3] {
+        let b = crate::read::parse(xml, "test.xml").unwrap();
+        tree_rows(xml, &b, rng).unwrap().unwrap()
+    }
+
+    /// Draws per first direction: 256 cells of 1/16 with one point each, and where leaves are
+    /// smaller each cell's point is dropped and its four quarters draw again.
+    #[test]
+    fn draw_counts_follow_leaf_size() {
+        // Constant rank-3 tree of 2 cells per side: radii 0.25 and 0.75, 256 points each.
+        let xml = refl_file("{ 1 1 1 1 1 1 1 1 }");
+        let mut rng = Drand48::new();
+        let r = rows(&xml, &mut rng);
+        let mut want = Drand48::new();
+        for _ in 0..2 * 256 * 2 {
+            want.next_f64();
+        }
+        assert_eq!(rng.next_f64(), want.next_f64());
+        // A constant tree is reciprocal: every pair 0 (Radiance's factor 1 + 1e-4·d is the
+        // same for a pair and its reverse only when they share a leaf, so not exactly 0).
+        match r[0] {
+            SampledRow::Values(v) => assert!(v.max < 3e-4 && v.min >= 0.0, "{v:?}"),
+            other => panic!("{other:?}"),
+        }
+        assert_eq!(r[1], SampledRow::Absent);
+        assert_eq!(r[2], SampledRow::Absent);
+        // 32 cells per side (leaves of 1/32): 32 radii, each 256 points dropped and 1024 kept.
+        let vals = vec!["1"; 1 << 15].join(" ");
+        let xml = refl_file(&format!("{{ {vals} }}"));
+        let mut rng = Drand48::new();
+        rows(&xml, &mut rng);
+        let mut want = Drand48::new();
+        for _ in 0..32 * (256 + 1024) * 2 {
+            want.next_f64();
+        }
+        assert_eq!(rng.next_f64(), want.next_f64());
+    }
+
+    #[test]
+    fn lambertian_split_and_lookup_cube() {
+        let node = parse_tree(
+            3,
+            "{ {1} {2} {3} {4} {0.1 0.2 0.3 0.4 0.5 0.6 0.7 0.8} {6} {7} {8} }",
+        )
+        .unwrap();
+        let mut t = Tree {
+            rank: 3,
+            side: Side::FrontRefl,
+            root: node,
+        };
+        // Only children 0, 2, 4, 6 (lower half of dimension 0) count: minimum 0.1, subtracted
+        // in float.
+        assert_eq!(t.lambertian_min(), 0.1);
+        assert_eq!(t.split_lambertian(), PI * f64::from(0.1f32));
+        // Child 4 (dimension 2 upper), its grid cell (1, 0, 1) = value 5.
+        let leaf = t.lookup(&[0.3, 0.2, 0.8, 0.0]);
+        assert_eq!(leaf.value, 0.6f32 - 0.1f32);
+        assert_eq!(leaf.corner, [0.25, 0.0, 0.75, 0.0]);
+        assert_eq!(leaf.edge, 0.25);
+        assert_eq!(t.smallest_leaf(), 0.25);
+        assert!(parse_tree(3, "{ 1 2 3 }").is_err());
+        assert!(parse_tree(3, "{ 1 } x").is_err());
+    }
+}
