@@ -1,9 +1,12 @@
 //! Native evaluation of the two bin expressions three-phase runs spend their time in:
 //! `kbin(...)`/`kbinN|E|S|W|D` of fenestra's `lib/klems_full.cal` and `rbin` of
 //! `lib/reinhart.cal`. They are used only when the loaded file is byte-identical to
-//! fenestra's own and no other definition touches the names involved; the arithmetic
-//! is the files' own, step for step, so the bins are the same numbers the .cal
-//! evaluator gives (checked over many directions by the tests below).
+//! fenestra's own and no other definition touches the names involved. `rbin` follows
+//! the file's arithmetic (the file tests the ground before the altitude and takes a
+//! row's constants from a select over the rows); `kbin` computes the polar angle with `acos`
+//! where klems_full.cal compares D.N with cosine thresholds derived from that angle
+//! test, so the bins are the same numbers the .cal evaluator gives (checked over many
+//! directions, ring boundaries included, by the tests below).
 
 use fenestra_trace::DVec3;
 
@@ -13,18 +16,22 @@ pub const KLEMS_FULL_CAL: &str = include_str!("../../../lib/klems_full.cal");
 pub const REINHART_CAL: &str = include_str!("../../../lib/reinhart.cal");
 
 /// Names whose (re)definition outside the shipped file disables the native path.
-pub const KLEMS_NAMES: [&str; 18] = [
+pub const KLEMS_NAMES: [&str; 22] = [
     "kf_deg",
-    "kf_bound",
-    "kf_naz",
-    "kf_before",
-    "kf_clamp",
-    "kf_ring",
-    "kf_col",
-    "kf_patch",
-    "kf_wrap",
+    "kf_c5",
+    "kf_c15",
+    "kf_c25",
+    "kf_c35",
+    "kf_c45",
+    "kf_c55",
+    "kf_c65",
+    "kf_c75",
+    "kf_c90",
+    "kf_t",
+    "kf_dot",
+    "kf_wrapped",
+    "kf_p",
     "kf_bin",
-    "kf_dn",
     "kbin",
     "kbinN",
     "kbinE",
@@ -35,8 +42,20 @@ pub const KLEMS_NAMES: [&str; 18] = [
 ];
 /// As [`KLEMS_NAMES`] for reinhart.cal.
 pub const REINHART_NAMES: [&str; 14] = [
-    "rh_deg", "rh_alpha", "rh_tnaz", "rh_tsum", "rh_naz", "rh_accum", "rh_clamp", "rh_alt",
-    "rh_azi0", "rh_azi", "rh_row", "rh_col", "rbin", "Nrbins",
+    "rh_deg",
+    "rh_alpha",
+    "rh_tnaz",
+    "rh_tsum",
+    "rh_naz",
+    "rh_accum",
+    "rh_alt",
+    "rh_row",
+    "rh_azi",
+    "rh_wrapped",
+    "rh_col",
+    "rh_bin",
+    "rbin",
+    "Nrbins",
 ];
 /// Built-ins the files use (a user definition of one of these disables the native path).
 pub const BUILTINS_USED: [&str; 6] = ["if", "select", "acos", "asin", "atan2", "floor"];
