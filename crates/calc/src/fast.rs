@@ -361,6 +361,8 @@ struct Fc<'a> {
     undo: Vec<Undo>,
     cse: HashMap<Key, u32>,
     nest: u32,
+    /// Temporaries written by a sum or a `floor` (never -0).
+    no_neg_zero: Vec<bool>,
 }
 
 fn is_k(r: u32) -> bool {
@@ -386,6 +388,7 @@ impl<'a> Fc<'a> {
             undo: Vec::new(),
             cse: HashMap::new(),
             nest: 0,
+            no_neg_zero: Vec::new(),
         }
     }
 
@@ -432,6 +435,13 @@ impl<'a> Fc<'a> {
         if let Some(k) = k {
             self.cse.insert(k, d);
             self.undo.push(Undo::Cse(k));
+        }
+        if matches!(op, Op::Add { .. } | Op::Floor { .. }) {
+            let i = d as usize;
+            if self.no_neg_zero.len() <= i {
+                self.no_neg_zero.resize(i + 1, false);
+            }
+            self.no_neg_zero[i] = true;
         }
         Ok(d)
     }
@@ -489,13 +499,19 @@ impl<'a> Fc<'a> {
 
     /// Compiles `n` with its value in `d` (nested `if`s write `d` directly).
     fn node_into(&mut self, n: &'a Node, fr: usize, d: u32) -> Result<(), GiveUp> {
-        match n {
+        let r = match n {
             Node::Lib(_, a) => return self.node_into(a, fr, d),
             Node::If(t) => return self.cond(&t.0, &t.1, &t.2, fr, Some(d)).map(|_| ()),
             Node::CallUser(f, args) => return self.call_user(*f, args, fr, Some(d)).map(|_| ()),
-            _ => {}
-        }
-        let r = self.node(n, fr)?;
+            Node::Builtin(Builtin::Select, args) if args.len() > 1 => {
+                let r = self.select(args, fr, Some(d))?;
+                if r == d {
+                    return Ok(());
+                }
+                r
+            }
+            _ => self.node(n, fr)?,
+        };
         // the op just emitted writes the value: let it write `d` instead
         let last = self
             .ops
@@ -571,7 +587,9 @@ impl<'a> Fc<'a> {
         Ok(d)
     }
 
-    fn select(&mut self, args: &'a [Node], fr: usize) -> Result<u32, GiveUp> {
+    /// `select`; a jump table writes its cases into `into` when given (the value is in
+    /// the register returned).
+    fn select(&mut self, args: &'a [Node], fr: usize, into: Option<u32>) -> Result<u32, GiveUp> {
         let ri = self.node(&args[0], fr)?;
         let count = args.len() - 1;
         if let Some(x) = self.kval(ri) {
@@ -597,7 +615,10 @@ impl<'a> Fc<'a> {
                 n: count as u32,
             });
         }
-        let d = self.temp();
+        let d = match into {
+            Some(d) => d,
+            None => self.temp(),
+        };
         let l = self.lists.len() as u32;
         // case k at lists[l + k - 1], the end (where index 0 goes) at lists[l + count]
         self.lists.extend(std::iter::repeat_n(0, count + 1));
@@ -633,7 +654,7 @@ impl<'a> Fc<'a> {
         }
         match b {
             Builtin::If => self.cond(&args[0], &args[1], &args[2], fr, None),
-            Builtin::Select => self.select(args, fr),
+            Builtin::Select => self.select(args, fr, None),
             Builtin::Math1(m) => self.math1(m, &args[0], fr),
             Builtin::Atan2 => self.atan2(&args[0], &args[1], fr),
             Builtin::Max | Builtin::Min => {
@@ -768,13 +789,38 @@ impl<'a> Fc<'a> {
                 let a = self.node(a, fr)?;
                 self.unary(a, |x| -x, |d, a| Op::Neg { d, a })
             }
-            Node::Add(p) => self.binary(
-                &p.0,
-                &p.1,
-                fr,
-                |x, y| Some(x + y + 0.0),
-                |d, a, b| Op::Add { d, a, b },
-            ),
+            Node::Add(p) => {
+                let r = self.binary(
+                    &p.0,
+                    &p.1,
+                    fr,
+                    |x, y| Some(x + y + 0.0),
+                    |d, a, b| Op::Add { d, a, b },
+                )?;
+                // x + ±0 is x when x is itself a sum or a floor (never -0)
+                if let Some(Op::Add { d, a, b }) = self.ops.last().copied() {
+                    if d == r && r + 1 == self.ntemp {
+                        let zero = |q: u32| self.kval(q) == Some(0.0);
+                        let nz =
+                            |q: u32| !is_k(q) && self.no_neg_zero.get(q as usize) == Some(&true);
+                        let keep = if zero(b) && nz(a) {
+                            Some(a)
+                        } else if zero(a) && nz(b) {
+                            Some(b)
+                        } else {
+                            None
+                        };
+                        if let Some(k) = keep {
+                            self.ops.pop();
+                            self.rollback_cse_of(d);
+                            self.ntemp -= 1;
+                            self.no_neg_zero[d as usize] = false;
+                            return Ok(k);
+                        }
+                    }
+                }
+                Ok(r)
+            }
             Node::Sub(p) => self.binary(
                 &p.0,
                 &p.1,
@@ -1613,7 +1659,8 @@ mod tests {
         let src = "$1 = floor($1 + $2); $2 = floor($1 - $2); $3 = floor($1 * $2);\n\
                    $4 = floor($1 / $2); $5 = 3*asin($1); $6 = $2*acos($1);\n\
                    $7 = -2*atan2($1, $2); $8 = if($1, 1, $2*$2) + 1;\n\
-                   $9 = $1 + $2*3; $10 = $1*$2 + 3; $11 = 2 - $1*$2; $12 = ($1 + $2) + -0;";
+                   $9 = $1 + $2*3; $10 = $1*$2 + 3; $11 = 2 - $1*$2; $12 = ($1 + $2) + $2;\n\
+                   $13 = ($1 + $2) + -0; $14 = 0 + floor($1); $15 = $1 + 0; $16 = $1*$2 + 0;";
         let special = [
             f64::NAN,
             -f64::NAN,
