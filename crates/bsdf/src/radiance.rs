@@ -14,29 +14,29 @@
 //! drops the remainder when its largest hemispherical total is ≤ 0.001; only that last case
 //! changes a transmission matrix (the split itself is added back), so it is what is reproduced.
 //! Colour: with `CIE-X` and `CIE-Z` blocks Radiance keeps each element's CIE Y and stores its
-//! chromaticity (u′, v′) quantised to steps of 1/410 with a dither: `k = floor(410·u′ + r)`,
-//! r from the C library's `drand48()` in its unseeded state (two numbers per element, u′ then
-//! v′). Found by experiment against the oracle's `rmtxop -ff`: the coloured components are
-//! encoded in the order XML `Reflection Back`, `Reflection Front`, `Transmission Back`,
-//! `Transmission Front` (Radiance rf, rb, tf, tb), each element of a component from the last
-//! stored index (`o·n_in + i`) down to the first, zero elements included. The RGB value is the
-//! XYZ → RGB transform (Radiance's standard primaries, equal-energy white) of (x/y·Y, Y,
-//! (1−x−y)/y·Y) from the decoded chromaticity; grey Y without colour blocks. Colours outside
-//! the RGB gamut are desaturated towards the grey of the same luminance until no channel is
-//! negative (found on remainders of a Lambertian split, which the oracle shows clipped so).
+//! chromaticity (u′, v′) quantised to steps of 1/410 with a dither: from the single-precision
+//! (x, y) = (X, Y)/(X + Y + Z) of the float values, `k = trunc(410·u′ + r)` clamped to 0…255, r
+//! from the C library's `drand48()` in its unseeded state (two numbers per element, u′ then v′).
+//! The coloured components are encoded in the order XML `Reflection Back`, `Reflection Front`,
+//! `Transmission Back`, `Transmission Front` (Radiance rf, rb, tf, tb), each element of a
+//! component from the last stored index (`o·n_in + i`) down to the first, zero elements included
+//! (as (1/3, 1/3)). The RGB value is the XYZ → RGB transform (Radiance's standard primaries,
+//! equal-energy white) of (x/y·Y, Y, (1−x−y)/y·Y) from the decoded single-precision chromaticity;
+//! grey Y without colour blocks. Colours outside the RGB gamut are desaturated towards the grey
+//! of the same luminance until no channel is negative (found on remainders of a Lambertian split,
+//! which the oracle shows clipped so).
 //!
-//! Coloured Lambertian split (found by experiment against the oracle's `rmtxop -ff`): right after
-//! a coloured component is encoded, every element's decoded colour is taken to the "sharp" RGB
-//! space (the Sharp chromatic-adaptation matrix of Süsstrunk, Holm and Finlayson) with each
-//! channel weighted by the luminance of its primary, so that the three weighted channels add up
-//! to Y. When the sum of the per-channel minima exceeds 0.01/π, those minima are the Lambertian
-//! part (its colour is their XYZ, its Y their sum) and are subtracted from every element; the
-//! remainders are quantised again with two more `drand48()` numbers each, incident patch in the
-//! outer loop and outgoing patch in the inner one (ascending), before the next component is
-//! encoded. On `coloured_xml(dir, true)` (tests/bsdf_xml.rs) 99% of the elements then agree with
-//! the oracle within 5e-4 per channel; the rest sit one 1/410 step off where a remainder's
-//! chromaticity lies within about 0.02 of a step boundary, because the oracle's Lambertian colour
-//! differs from ours by up to 5e-4 per channel (cause not found).
+//! Coloured Lambertian split (Radiance's BSDF library, facts only): right after a coloured
+//! component is encoded, every element's value (times Radiance's position factor
+//! `1 + 6e-4·(d − ½)`) and decoded chromaticity are taken to Sharp RGB (the chromatic-adaptation
+//! matrix of Süsstrunk, Holm and Finlayson, single precision) with each channel weighted by its
+//! primary's luminance from Radiance's four-decimal Sharp → XYZ table. When the sum of the
+//! per-channel minima exceeds 0.01/π, those minima are the Lambertian part (its colour through
+//! that table, its Y their sum); every element keeps its value minus that sum as luminance, and
+//! its remainder's colour is quantised again with two more `drand48()` numbers, incident patch in
+//! the outer loop and outgoing patch in the inner one, unless the remainder's luminance is at
+//! most 1e-5 (no numbers drawn). On `coloured_xml(dir, true)` (tests/bsdf_xml.rs) every channel
+//! of every element agrees with the oracle within 5.2e-7.
 
 use crate::klems::KlemsBasis;
 use crate::model::{Bsdf, Direction, KlemsMatrix, Wavelength};
@@ -134,14 +134,6 @@ fn inv3(m: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
     ]
 }
 
-/// CIE XYZ → "sharp" RGB: the Sharp chromatic-adaptation matrix (Süsstrunk, Holm and Finlayson,
-/// 2001), the space in which Radiance splits a coloured Lambertian part off (see the module doc).
-const XYZ_TO_SHARP: [[f64; 3]; 3] = [
-    [1.2694, -0.0988, -0.1706],
-    [-0.8364, 1.8006, 0.0357],
-    [0.0297, -0.0315, 1.0018],
-];
-
 /// Desaturates `rgb` towards the grey of luminance `y` until no channel is negative.
 fn clip_gamut(rgb: [f64; 3], y: f64) -> [f64; 3] {
     let mut t = 1.0f64;
@@ -159,23 +151,11 @@ fn clip_gamut(rgb: [f64; 3], y: f64) -> [f64; 3] {
 
 /// CIE XYZ of a colour given as a quantised (u′, v′) pair and a luminance; `None` when the
 /// chromaticity is degenerate.
-fn chroma_xyz((ub, vb): (f64, f64), y: f64) -> Option<[f64; 3]> {
-    let (u, v) = (ub / UV_STEPS, vb / UV_STEPS);
-    let d = 6.0 * u - 16.0 * v + 12.0;
-    let (cx, cy) = (9.0 * u / d, 4.0 * v / d);
-    (cy > 0.0).then(|| [cx / cy * y, y, (1.0 - cx - cy) / cy * y])
-}
-
-/// Quantised (u′, v′) of a CIE XYZ colour with two dither numbers; `None` when X + 15Y + 3Z is
-/// not positive (the numbers are drawn in any case).
-fn quantise(xyz: [f64; 3], rng: &mut Drand48) -> Option<(f64, f64)> {
-    let (r1, r2) = (rng.next_f64(), rng.next_f64());
-    let d = xyz[0] + 15.0 * xyz[1] + 3.0 * xyz[2];
-    (d > 0.0).then(|| {
-        (
-            (4.0 * xyz[0] / d * UV_STEPS + r1).floor().clamp(0.0, 255.0),
-            (9.0 * xyz[1] / d * UV_STEPS + r2).floor().clamp(0.0, 255.0),
-        )
+fn chroma_xyz(code: (f64, f64), y: f64) -> Option<[f64; 3]> {
+    let (cx, cy) = decode_xy(code);
+    (cy > 0.0).then(|| {
+        let (x, yy) = (f64::from(cx), f64::from(cy));
+        [f64::from(cx / cy) * y, y, (1.0 - x - yy) / yy * y]
     })
 }
 
@@ -203,8 +183,70 @@ impl Drand48 {
 /// Steps per unit of u′ and v′ in Radiance's chromaticity encoding.
 const UV_STEPS: f64 = 410.0;
 
+/// Radiance's XYZ → Sharp RGB matrix, as it stores it (single precision).
+const XYZ_TO_SHARP_F: [[f32; 3]; 3] = [
+    [1.2694, -0.0988, -0.1706],
+    [-0.8364, 1.8006, 0.0357],
+    [0.0297, -0.0315, 1.0018],
+];
+
+/// Radiance's Sharp RGB → XYZ matrix: its own four-decimal table (single precision), not the
+/// exact inverse of [`XYZ_TO_SHARP_F`].
+const XYZ_FROM_SHARP_F: [[f32; 3]; 3] = [
+    [0.8156, 0.0472, 0.1372],
+    [0.3791, 0.5769, 0.0440],
+    [-0.0123, 0.0167, 0.9955],
+];
+
+/// Quantised (u′, v′) indices of a CIE (x, y) chromaticity (single precision, as Radiance
+/// keeps it) with two dither numbers, u′ first; indices truncated and clamped to 0…255.
+fn encode_xy(cx: f32, cy: f32, rng: &mut Drand48) -> (f64, f64) {
+    let (cx, cy) = (f64::from(cx), f64::from(cy));
+    let df = UV_STEPS / (-2.0 * cx + 12.0 * cy + 3.0);
+    let ub = (4.0 * cx * df + rng.next_f64()) as i32;
+    let vb = (9.0 * cy * df + rng.next_f64()) as i32;
+    (f64::from(ub.clamp(0, 255)), f64::from(vb.clamp(0, 255)))
+}
+
+/// CIE (x, y) (single precision) of quantised (u′, v′) indices, as Radiance decodes them.
+fn decode_xy((ub, vb): (f64, f64)) -> (f32, f32) {
+    let (up, vp) = (ub * (1.0 / UV_STEPS), vb * (1.0 / UV_STEPS));
+    let df = 1.0 / (6.0 * up - 16.0 * vp + 12.0);
+    ((9.0 * up * df) as f32, (4.0 * vp * df) as f32)
+}
+
+/// Sharp RGB (single precision) of chromaticity (x, y) at luminance `y`.
+fn to_sharp((cx, cy): (f32, f32), y: f64) -> [f32; 3] {
+    let xyz = [
+        f64::from(cx / cy) * y,
+        y,
+        (1.0 - f64::from(cx) - f64::from(cy)) / f64::from(cy) * y,
+    ];
+    XYZ_TO_SHARP_F.map(|r| {
+        (f64::from(r[0]) * xyz[0] + f64::from(r[1]) * xyz[1] + f64::from(r[2]) * xyz[2]) as f32
+    })
+}
+
+/// Luminance and chromaticity of a Sharp RGB colour (Radiance's table); the chromaticity is
+/// `None` (Radiance's default white) when the luminance is at most 1e-6.
+fn from_sharp(c: [f32; 3]) -> (f64, Option<(f32, f32)>) {
+    let row = |r: [f32; 3]| {
+        f64::from(r[0]) * f64::from(c[0])
+            + f64::from(r[1]) * f64::from(c[1])
+            + f64::from(r[2]) * f64::from(c[2])
+    };
+    let y = row(XYZ_FROM_SHARP_F[1]);
+    if y <= 1e-6 {
+        return (y, None);
+    }
+    let (x, z) = (row(XYZ_FROM_SHARP_F[0]), row(XYZ_FROM_SHARP_F[2]));
+    let sf = 1.0 / (x + y + z);
+    (y, Some(((x * sf) as f32, (y * sf) as f32)))
+}
+
 /// Dithered (u′, v′) lattice indices of every element of a coloured component, indexed
-/// `o · n_in + i`; `None` where X + 15Y + 3Z is not positive.
+/// `o · n_in + i`: Radiance's chromaticity x/(X+Y+Z), y/(X+Y+Z) of the single-precision values
+/// (1/3, 1/3 for a zero element), elements from the last stored index down to the first.
 fn encode_chroma(
     y: &KlemsMatrix,
     x: &KlemsMatrix,
@@ -215,56 +257,76 @@ fn encode_chroma(
     let mut out = vec![None; ni * no];
     for k in (0..ni * no).rev() {
         let (o, i) = (k / ni, k % ni);
-        out[k] = quantise([x.get(o, i), y.get(o, i), z.get(o, i)], rng);
+        let [xv, yv, zv] = [x.get(o, i), y.get(o, i), z.get(o, i)].map(|v| v.max(0.0) as f32);
+        let sum = f64::from(xv + yv + zv);
+        let (cx, cy) = if sum > 0.0 {
+            ((f64::from(xv) / sum) as f32, (f64::from(yv) / sum) as f32)
+        } else {
+            ((1.0f64 / 3.0) as f32, (1.0f64 / 3.0) as f32)
+        };
+        out[k] = Some(encode_xy(cx, cy, rng));
     }
     out
 }
 
-/// A coloured component's Lambertian split, as Radiance does it (module doc): `None` when the
-/// sum of the sharp-RGB minima is not above 0.01/π. Otherwise the remainders' chromaticities
-/// replace `chroma` and their luminances and the Lambertian part's CIE XYZ are returned.
+/// A coloured component's Lambertian split, as Radiance does it: each element's value (single
+/// precision, times Radiance's position factor `1 + 6e-4·(d − ½)`, d the fraction of
+/// `2·n_in/(i + 0.22545) + 4·n_out/(o + 0.70281)`) taken to Sharp RGB with each channel
+/// weighted by its primary's luminance (Radiance's four-decimal table); the per-channel minima
+/// are the Lambertian part when their sum exceeds 0.01/π. Each remainder (incident patch in the
+/// outer loop) is quantised again with two dither numbers, unless its luminance is at most
+/// 1e-5 (then its chromaticity is kept and nothing is drawn); its luminance is the value minus
+/// that sum. `None` without a split; otherwise the remainders' luminances and the Lambertian
+/// part's CIE XYZ.
 fn split_colour(
     y: &KlemsMatrix,
     chroma: &mut [Option<(f64, f64)>],
     rng: &mut Drand48,
 ) -> Option<(Vec<f64>, [f64; 3])> {
-    let sharp_to_xyz = inv3(&XYZ_TO_SHARP);
-    // Luminance of each sharp primary: the weights that make the channels add up to Y.
-    let w = sharp_to_xyz[1];
+    let w = XYZ_FROM_SHARP_F[1];
     let (ni, no) = (y.incident.len(), y.outgoing.len());
-    let coef: Vec<[f64; 3]> = (0..ni * no)
-        .map(|k| {
-            let yv = y.values[k];
-            let xyz = chroma[k].and_then(|c| chroma_xyz(c, yv)).unwrap_or([yv; 3]);
-            let s = mul3(&XYZ_TO_SHARP, xyz);
-            [s[0] * w[0], s[1] * w[1], s[2] * w[2]]
-        })
-        .collect();
-    let mut min = [f64::INFINITY; 3];
-    for c in &coef {
-        for ch in 0..3 {
-            min[ch] = min[ch].min(c[ch]);
+    let coef = |chroma: &[Option<(f64, f64)>], i: usize, o: usize| -> [f32; 3] {
+        let k = o * ni + i;
+        let d = (2 * ni) as f64 / (i as f64 + 0.22545) + (4 * no) as f64 / (o as f64 + 0.70281);
+        let d = d - d.trunc();
+        let v = (f64::from(y.values[k].max(0.0) as f32) * (1.0 + 6e-4 * (d - 0.5))) as f32;
+        let xy = decode_xy(chroma[k].unwrap_or((0.0, 0.0)));
+        let s = to_sharp(xy, f64::from(v));
+        [s[0] * w[0], s[1] * w[1], s[2] * w[2]]
+    };
+    let mut min = [1e10f32; 3];
+    for i in 0..ni {
+        for o in 0..no {
+            let c = coef(chroma, i, o);
+            for ch in 0..3 {
+                min[ch] = min[ch].min(c[ch]);
+            }
         }
     }
-    let sum: f64 = min.iter().sum();
-    if sum.is_nan() || sum <= 0.01 / std::f64::consts::PI {
+    let ymin = 0.0f32 + min[2] + min[1] + min[0];
+    if ymin.is_nan() || f64::from(ymin) <= 0.01 / std::f64::consts::PI {
         return None;
     }
-    let to_xyz = |c: [f64; 3]| mul3(&sharp_to_xyz, [c[0] / w[0], c[1] / w[1], c[2] / w[2]]);
     let mut rest = vec![0.0; ni * no];
     for i in 0..ni {
         for o in 0..no {
             let k = o * ni + i;
-            let r = [
-                coef[k][0] - min[0],
-                coef[k][1] - min[1],
-                coef[k][2] - min[2],
-            ];
-            chroma[k] = quantise(to_xyz(r), rng);
-            rest[k] = r.iter().sum();
+            let c = coef(chroma, i, o);
+            let r = [0, 1, 2].map(|ch| (c[ch] - min[ch]) / w[ch]);
+            if let (lum, Some((cx, cy))) = from_sharp(r) {
+                if lum > 1e-5 {
+                    chroma[k] = Some(encode_xy(cx, cy, rng));
+                }
+            }
+            rest[k] = f64::from(y.values[k].max(0.0) as f32 - ymin);
         }
     }
-    Some((rest, to_xyz(min)))
+    let (_, lxy) = from_sharp([0, 1, 2].map(|ch| min[ch] / w[ch]));
+    let (cx, cy) = lxy.map_or((1.0 / 3.0, 1.0 / 3.0), |(x, y)| {
+        (f64::from(x), f64::from(y))
+    });
+    let yl = f64::from(ymin);
+    Some((rest, [cx / cy * yl, yl, (1.0 - cx - cy) / cy * yl]))
 }
 
 /// Colour of a component: quantised chromaticity per element and, after a Lambertian split,
