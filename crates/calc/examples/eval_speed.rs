@@ -2,6 +2,9 @@
 //! expressions a contribution run evaluates per ray hit: `rbin` (reinhart.cal, MF 1)
 //! and `kbin` (klems_full.cal) with host-bound `Dx Dy Dz`, the way crates/contrib uses
 //! the language. Run: `cargo run --profile testopt -p fenestra-calc --example eval_speed`.
+//! The directions cover the sphere; half are ground for `rbin` (0, no angles computed)
+//! and half lie behind the window for `kbin` (-1): the `sky` and `front` lines time
+//! those expressions on the other half only.
 
 use std::path::Path;
 use std::time::Instant;
@@ -102,4 +105,10 @@ fn main() {
     bench("kbin", "", "klems_full.cal", "kbin(0,1,0,0,0,1)", &ds);
     bench("kbinS", "", "klems_full.cal", "kbinS", &ds);
     native_rbin(&ds);
+    // the same number of directions, each on the side that is binned by angle
+    let sky: Vec<[f64; 3]> = ds.iter().map(|d| [d[0], d[1], d[2].abs()]).collect();
+    let front: Vec<[f64; 3]> = ds.iter().map(|d| [d[0], -d[1].abs(), d[2]]).collect();
+    bench("sky", "MF:1", "reinhart.cal", "rbin", &sky);
+    bench("front", "", "klems_full.cal", "kbin(0,1,0,0,0,1)", &front);
+    native_rbin(&sky);
 }
