@@ -7,6 +7,10 @@ use anyhow::{bail, Context, Result};
 use fenestra_trace::{DVec3, TraceOptions, Tracer};
 use rayon::prelude::*;
 
+/// Input records per block of source-thresholding statistics (`-dt > 0`): a block is
+/// traced in order by one thread, so the output does not depend on `-n`.
+const BLOCK: usize = 64;
+
 const USAGE: &str = "[-I|-i][-o{o,d,v,w,l,L,p,n,N}][-f{a,f,d}{a,f,d}][-h][-x N][-y N][-n N][-ab N][-ad N][-aa V][-ar N][-as N][-av r g b][-lw W][-lr N][-ds V][-dj V][-dc V][-dr N][-dt V][-st V][-ss V][-bv][-u][-v][-full][-seed N] scene.{rad,oct}…";
 
 #[derive(Clone, Copy, PartialEq)]
@@ -153,9 +157,18 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     for w in tracer.warnings() {
         fenestra_cli::warn(w);
     }
+    // With source thresholding the shadow-test statistics are carried from record to
+    // record within a block of BLOCK consecutive records, traced in order by one thread.
+    let block = if tracer.thresholding() { BLOCK } else { 1 };
     if verbose {
         for n in &tracer.effects().notes {
             eprintln!("{}: {n}", fenestra_cli::prog());
+        }
+        if block > 1 {
+            eprintln!(
+                "{}: source thresholding: hit statistics and obstructor caches start afresh every {block} input records",
+                fenestra_cli::prog()
+            );
         }
     }
     if tracer.source_count() == 0 && !outspec.chars().all(|c| "odlLpnN".contains(c)) {
@@ -190,42 +203,51 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let chunk = 1024;
     for start in (0..n).step_by(chunk) {
         let end = (start + chunk).min(n);
-        let vals: Vec<Vec<f64>> = pool.install(|| {
-            (start..end)
-                .into_par_iter()
-                .map(|k| {
-                    let (org, dir) = rays[k];
-                    let mut rec = Vec::new();
-                    let hit = if outspec.chars().any(|c| "lLpnN".contains(c)) {
-                        Some(tracer.first_hit(org, dir))
-                    } else {
-                        None
-                    };
-                    for c in outspec.chars() {
-                        match c {
-                            'o' => rec.extend(org.to_array()),
-                            'd' => rec.extend(dir.normalize_or_zero().to_array()),
-                            'v' | 'V' => {
-                                let v = if dir == DVec3::ZERO {
-                                    [0.0; 3]
-                                } else if irr {
-                                    tracer.irradiance(k as u64, org, dir)
-                                } else if irr_hit {
-                                    tracer.irradiance_at_hit(k as u64, org, dir)
-                                } else {
-                                    tracer.radiance(k as u64, org, dir)
-                                };
-                                rec.extend(v);
-                            }
-                            'w' => rec.push(1.0),
-                            'l' | 'L' => rec.push(hit.map_or(0.0, |h| h.t)),
-                            'p' => rec.extend(hit.map_or([0.0; 3], |h| h.point.to_array())),
-                            _ => rec.extend(hit.map_or([0.0; 3], |h| h.normal.to_array())),
-                        }
+        let record = |k: usize, st: &mut fenestra_trace::DirectState| {
+            let (org, dir) = rays[k];
+            let mut rec = Vec::new();
+            let hit = if outspec.chars().any(|c| "lLpnN".contains(c)) {
+                Some(tracer.first_hit(org, dir))
+            } else {
+                None
+            };
+            for c in outspec.chars() {
+                match c {
+                    'o' => rec.extend(org.to_array()),
+                    'd' => rec.extend(dir.normalize_or_zero().to_array()),
+                    'v' | 'V' => {
+                        let v = if dir == DVec3::ZERO {
+                            [0.0; 3]
+                        } else if irr {
+                            tracer.irradiance_with(st, k as u64, org, dir)
+                        } else if irr_hit {
+                            tracer.irradiance_at_hit_with(st, k as u64, org, dir)
+                        } else {
+                            tracer.radiance_with(st, k as u64, org, dir)
+                        };
+                        rec.extend(v);
                     }
-                    rec
+                    'w' => rec.push(1.0),
+                    'l' | 'L' => rec.push(hit.map_or(0.0, |h| h.t)),
+                    'p' => rec.extend(hit.map_or([0.0; 3], |h| h.point.to_array())),
+                    _ => rec.extend(hit.map_or([0.0; 3], |h| h.normal.to_array())),
+                }
+            }
+            rec
+        };
+        let vals: Vec<Vec<f64>> = pool.install(|| {
+            let blocks: Vec<Vec<Vec<f64>>> = (start..end)
+                .step_by(block)
+                .collect::<Vec<_>>()
+                .into_par_iter()
+                .map(|b| {
+                    let mut st = tracer.direct_state();
+                    (b..(b + block).min(end))
+                        .map(|k| record(k, &mut st))
+                        .collect()
                 })
-                .collect()
+                .collect();
+            blocks.into_iter().flatten().collect()
         });
         for rec in vals {
             match fout {

@@ -25,4 +25,4 @@ pub mod tracer;
 
 pub use glam::DVec3;
 pub use options::TraceOptions;
-pub use tracer::{Contribution, Effects, Tracer};
+pub use tracer::{Contribution, DirectState, Effects, Tracer};

@@ -15,11 +15,13 @@ pub struct TraceOptions {
     pub ds: f64,
     /// `-dj`: source jitter (0..1).
     pub dj: f64,
-    /// `-dc`: source certainty (accepted; every shadow ray is traced).
+    /// `-dc`: source certainty: with thresholding, the next ⌊n^dc + ½⌋ of n source samples
+    /// are weighed against the threshold (1: all the rest, 0: one at a time).
     pub dc: f64,
     /// `-dr`: relays (accepted; virtual sources are not modelled).
     pub dr: i32,
-    /// `-dt`: direct threshold (accepted; every shadow ray is traced, as with `-dt 0`).
+    /// `-dt`: direct threshold: source samples whose potential is below this fraction of
+    /// what the ray has gathered are not shadow-tested (0: every sample is tested).
     pub dt: f64,
     /// `-st`: specular sampling threshold.
     pub st: f64,

@@ -20,6 +20,10 @@ use crate::polygon::Polygon;
 use crate::rng::Rng;
 use crate::shape::Shape;
 
+mod threshold;
+pub use threshold::DirectState;
+use threshold::{ObsCache, SourceSample};
+
 const SHADOW: u8 = 1;
 const REFLECTED: u8 = 2;
 const TRANS: u8 = 4;
@@ -108,6 +112,8 @@ struct Ctx<'a> {
     rays: u64,
     tracked: &'a [bool],
     sink: Option<&'a mut dyn FnMut(Contribution)>,
+    /// Source-thresholding state (only when thresholding applies).
+    ds: Option<&'a mut DirectState>,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -176,6 +182,10 @@ pub struct Tracer {
     effects: Effects,
     warnings: Vec<String>,
     rays: std::sync::atomic::AtomicU64,
+    /// With source thresholding: every source's initial obstructor cache.
+    obs: Option<Vec<Option<ObsCache>>>,
+    /// Per BVH shape: a reliable shadow-ray blocker (opaque material, never clipped).
+    blocker: Vec<bool>,
 }
 
 fn maxc(c: DVec3) -> f64 {
@@ -497,7 +507,39 @@ impl Tracer {
                 .into()
         });
         let specular = specular || opts.full;
-        Ok(Tracer {
+        let threshold = direct && Self::wants_threshold(opts, &sources);
+        notes.push(if threshold {
+            format!(
+                "source thresholding: on (-dt {} -dc {}, {} source(s)): only the brightest source samples are shadow-tested",
+                opts.dt,
+                opts.dc,
+                sources.len()
+            )
+        } else if opts.dt > 0.0 && direct {
+            format!("source thresholding: off (-dt {}, but at most 2 source samples per point: all tested)", opts.dt)
+        } else {
+            format!("source thresholding: off (-dt {}): every source sample is shadow-tested", opts.dt)
+        });
+        let clipped: Vec<usize> = mats
+            .values()
+            .filter_map(|m| match m {
+                Material::Antimatter { mods, .. } => Some(mods.iter().copied()),
+                _ => None,
+            })
+            .flatten()
+            .collect();
+        // Radiance's opaque material types (a shadow ray meeting one stops there; a
+        // light or spotlight stops shadow rays aimed at other sources)
+        let blocker = surf_mat
+            .iter()
+            .map(|m| {
+                matches!(
+                    scene.prims[*m].ptype.as_str(),
+                    "plastic" | "metal" | "light" | "spotlight"
+                ) && !clipped.contains(m)
+            })
+            .collect();
+        let mut tracer = Tracer {
             accel: Accel::new(shapes),
             surf_prim,
             surf_mat,
@@ -516,7 +558,13 @@ impl Tracer {
             },
             warnings,
             rays: std::sync::atomic::AtomicU64::new(0),
-        })
+            obs: None,
+            blocker,
+        };
+        if threshold {
+            tracer.obs = Some(tracer.build_caches());
+        }
+        Ok(tracer)
     }
 
     /// Warnings found while preparing the scene (degenerate polygons …).
@@ -552,12 +600,27 @@ impl Tracer {
     }
 
     /// Radiance along a ray (`dir` need not be unit; a zero direction gives zero).
+    /// With source thresholding the hit statistics start afresh for this ray; see
+    /// [`radiance_with`](Self::radiance_with) to carry them over rays.
     pub fn radiance(&self, ray_index: u64, org: DVec3, dir: DVec3) -> [f64; 3] {
+        self.radiance_with(&mut self.direct_state(), ray_index, org, dir)
+    }
+
+    /// As [`radiance`](Self::radiance), using and updating the source-thresholding
+    /// state `st` (hit statistics and obstructor caches carried from ray to ray).
+    pub fn radiance_with(
+        &self,
+        st: &mut DirectState,
+        ray_index: u64,
+        org: DVec3,
+        dir: DVec3,
+    ) -> [f64; 3] {
         let mut cx = Ctx {
             rng: Rng::for_ray(self.opts.seed, ray_index),
             rays: 0,
             tracked: &[],
             sink: None,
+            ds: self.thresholding().then_some(st),
         };
         let d = dir.normalize_or_zero();
         if d == DVec3::ZERO {
@@ -570,11 +633,24 @@ impl Tracer {
 
     /// Irradiance at `point` on a surface facing `normal` (rtrace `-I`).
     pub fn irradiance(&self, ray_index: u64, point: DVec3, normal: DVec3) -> [f64; 3] {
+        self.irradiance_with(&mut self.direct_state(), ray_index, point, normal)
+    }
+
+    /// As [`irradiance`](Self::irradiance) with a source-thresholding state (see
+    /// [`radiance_with`](Self::radiance_with)).
+    pub fn irradiance_with(
+        &self,
+        st: &mut DirectState,
+        ray_index: u64,
+        point: DVec3,
+        normal: DVec3,
+    ) -> [f64; 3] {
         let mut cx = Ctx {
             rng: Rng::for_ray(self.opts.seed, ray_index),
             rays: 0,
             tracked: &[],
             sink: None,
+            ds: self.thresholding().then_some(st),
         };
         let n = normal.normalize_or_zero();
         if n == DVec3::ZERO {
@@ -619,6 +695,7 @@ impl Tracer {
             rays: 0,
             tracked,
             sink: Some(sink),
+            ds: None,
         };
         let r = Ray {
             tmax: len,
@@ -648,6 +725,7 @@ impl Tracer {
             rays: 0,
             tracked,
             sink: Some(sink),
+            ds: None,
         };
         let v = self.irradiance_in(point, n, &mut cx);
         self.count(&cx);
@@ -667,13 +745,20 @@ impl Tracer {
             ..Self::primary(p, -n)
         };
         let rho = DVec3::splat(PI);
-        let mut val = self.direct(&r, p, n, None, cx, |_l, omega, ldot| {
+        let lamb = |_l: DVec3, omega: f64, ldot: f64| {
             if ldot > 0.0 {
                 rho * (ldot * omega / PI)
             } else {
                 DVec3::ZERO
             }
-        });
+        };
+        if cx.ds.is_some() {
+            // thresholding: direct light last, as Radiance (its threshold is relative
+            // to what the surface already returns)
+            let amb = self.ambient(&r, p, n, rho, None, cx);
+            return amb + self.direct(&r, p, n, None, amb, cx, lamb);
+        }
+        let mut val = self.direct(&r, p, n, None, DVec3::ZERO, cx, lamb);
         val += self.ambient(&r, p, n, rho, None, cx);
         val
     }
@@ -1094,16 +1179,24 @@ impl Tracer {
         };
         let td = b.td;
         let side = if front { z } else { -z };
-        let mut val = self.direct(r, p, side, Some(shape), cx, |l, omega, ldot| {
-            let ll = to_local(l);
-            let same = (ll.z > 0.0) == front;
-            let f = if same {
-                DVec3::splat(refl.map_or(0.0, |c| c.eval(v, ll))) + rd / PI
-            } else {
-                DVec3::splat(trans.map_or(0.0, |c| c.eval(v, ll))) + td / PI
-            };
-            f * (ldot.abs() * omega)
-        });
+        let mut val = self.direct(
+            r,
+            p,
+            side,
+            Some(shape),
+            DVec3::ZERO,
+            cx,
+            |l, omega, ldot| {
+                let ll = to_local(l);
+                let same = (ll.z > 0.0) == front;
+                let f = if same {
+                    DVec3::splat(refl.map_or(0.0, |c| c.eval(v, ll))) + rd / PI
+                } else {
+                    DVec3::splat(trans.map_or(0.0, |c| c.eval(v, ll))) + td / PI
+                };
+                f * (ldot.abs() * omega)
+            },
+        );
         for (comp, flag) in [(refl, REFLECTED), (trans, TRANS)] {
             let Some(c) = comp else { continue };
             let (u, u0, u1) = (cx.rng.next_f64(), cx.rng.next_f64(), cx.rng.next_f64());
@@ -1263,7 +1356,7 @@ impl Tracer {
         }
         let flat = self.accel.shapes[shape].is_flat();
         let d = r.dir;
-        let mut val = self.direct(r, p, nrm, Some(shape), cx, |l, omega, ldot| {
+        let lobe = |l: DVec3, omega: f64, ldot: f64| {
             let mut c = DVec3::ZERO;
             if ldot > 0.0 {
                 let mut dr = rdiff;
@@ -1289,7 +1382,15 @@ impl Tracer {
                 c += color * (tdiff * -ldot * omega / PI);
             }
             c
-        });
+        };
+        // With thresholding, direct light comes last, as in Radiance (its threshold is
+        // relative to what the surface already returns); otherwise first.
+        let last = cx.ds.is_some();
+        let mut val = if last {
+            DVec3::ZERO
+        } else {
+            self.direct(r, p, nrm, Some(shape), DVec3::ZERO, cx, lobe)
+        };
         if self.effects.specular {
             if rspec > FTINY && pure {
                 let dir = (d + nrm * (2.0 * pdot)).normalize();
@@ -1327,17 +1428,25 @@ impl Tracer {
         if tdiff > FTINY {
             val += self.ambient(r, p, -nrm, color * tdiff, Some(shape), cx);
         }
+        if last {
+            val += self.direct(r, p, nrm, Some(shape), val, cx, lobe);
+        }
         val
     }
 
     /// Direct lighting at `p` (normal `nrm`): `bsdf(l, omega, ldot)` gives the coefficient
-    /// of a source sample; a shadow ray fetches the source's radiance.
+    /// of a source sample; a shadow ray fetches the source's radiance. With source
+    /// thresholding (`-dt > 0`, a [`DirectState`] in `cx`), only the brightest samples are
+    /// shadow-tested ([`Self::direct_threshold`]); `prior` is what the surface already
+    /// returns from its other components (Radiance computes direct light last).
+    #[allow(clippy::too_many_arguments)]
     fn direct(
         &self,
         r: &Ray,
         p: DVec3,
         nrm: DVec3,
         shape: Option<usize>,
+        prior: DVec3,
         cx: &mut Ctx,
         bsdf: impl Fn(DVec3, f64, f64) -> DVec3,
     ) -> DVec3 {
@@ -1345,83 +1454,105 @@ impl Tracer {
         if !self.effects.direct {
             return val;
         }
+        if cx.ds.is_some() {
+            return self.direct_threshold(r, p, nrm, shape, prior, cx, bsdf);
+        }
         let skip = shape.filter(|&s| self.accel.shapes[s].is_flat());
-        for (si, s) in self.sources.iter().enumerate() {
-            match s.geom {
-                SourceGeom::Distant(k) => {
-                    let d = &self.distant[k];
-                    let l = self.jitter_cone(d.dir, d.cos_half, cx);
-                    let ldot = l.dot(nrm);
-                    self.shadow(
-                        r,
-                        p,
+        for si in 0..self.sources.len() {
+            self.each_sample(si, p, shape, cx, |cx, s| {
+                let ldot = s.l.dot(nrm);
+                self.shadow(
+                    r,
+                    p,
+                    s.l,
+                    s.tmax,
+                    si,
+                    skip,
+                    bsdf(s.l, s.omega, ldot),
+                    &mut val,
+                    cx,
+                );
+            });
+        }
+        val
+    }
+
+    /// Calls `f` for every sample of source `si` seen from `p` (on surface `shape`): its
+    /// unit direction, solid angle, shadow-ray length and the number of samples drawn
+    /// for the source. Samples are drawn (random numbers used) before the first call.
+    fn each_sample(
+        &self,
+        si: usize,
+        p: DVec3,
+        shape: Option<usize>,
+        cx: &mut Ctx,
+        mut f: impl FnMut(&mut Ctx, SourceSample),
+    ) {
+        let s = &self.sources[si];
+        match s.geom {
+            SourceGeom::Distant(k) => {
+                let d = &self.distant[k];
+                let l = self.jitter_cone(d.dir, d.cos_half, cx);
+                f(
+                    cx,
+                    SourceSample {
                         l,
-                        f64::INFINITY,
-                        si,
-                        skip,
-                        bsdf(l, d.omega, ldot),
-                        &mut val,
-                        cx,
-                    );
+                        omega: d.omega,
+                        tmax: f64::INFINITY,
+                        count: 1,
+                    },
+                );
+            }
+            SourceGeom::Virtual { base, mirror, dir } => {
+                if Some(mirror) == shape {
+                    return;
                 }
-                SourceGeom::Virtual { base, mirror, dir } => {
-                    if Some(mirror) == shape {
-                        continue;
-                    }
-                    let SourceGeom::Distant(k) = self.sources[base].geom else {
-                        continue;
-                    };
-                    let d = &self.distant[k];
-                    let l = self.jitter_cone(dir, d.cos_half, cx);
-                    let ldot = l.dot(nrm);
-                    self.shadow(
-                        r,
-                        p,
+                let SourceGeom::Distant(k) = self.sources[base].geom else {
+                    return;
+                };
+                let d = &self.distant[k];
+                let l = self.jitter_cone(dir, d.cos_half, cx);
+                f(
+                    cx,
+                    SourceSample {
                         l,
-                        f64::INFINITY,
-                        si,
-                        skip,
-                        bsdf(l, d.omega, ldot),
-                        &mut val,
-                        cx,
-                    );
+                        omega: d.omega,
+                        tmax: f64::INFINITY,
+                        count: 1,
+                    },
+                );
+            }
+            SourceGeom::Local(sh) => {
+                if Some(sh) == shape {
+                    return;
                 }
-                SourceGeom::Local(sh) => {
-                    if Some(sh) == shape {
+                let maxrad = match &self.mats[&s.mat] {
+                    Material::Light {
+                        kind: LightKind::Glow(rad),
+                        ..
+                    } => *rad,
+                    _ => f64::INFINITY,
+                };
+                let samples = self.source_samples(sh, p, cx);
+                let count = samples.len();
+                for (q, omega) in samples {
+                    let v = q - p;
+                    let dist = v.length();
+                    if dist <= 0.0 || dist > maxrad || omega <= 0.0 {
                         continue;
                     }
-                    let maxrad = match &self.mats[&s.mat] {
-                        Material::Light {
-                            kind: LightKind::Glow(rad),
-                            ..
-                        } => *rad,
-                        _ => f64::INFINITY,
-                    };
-                    let samples = self.source_samples(sh, p, cx);
-                    for (q, omega) in samples {
-                        let v = q - p;
-                        let dist = v.length();
-                        if dist <= 0.0 || dist > maxrad || omega <= 0.0 {
-                            continue;
-                        }
-                        let l = v / dist;
-                        let ldot = l.dot(nrm);
-                        self.shadow(
-                            r,
-                            p,
-                            l,
-                            dist * (1.0 + 1e-7) + Self::tmin(q),
-                            si,
-                            skip,
-                            bsdf(l, omega, ldot),
-                            &mut val,
-                            cx,
-                        );
-                    }
+                    f(
+                        cx,
+                        SourceSample {
+                            l: v / dist,
+                            omega,
+                            tmax: dist * (1.0 + 1e-7) + Self::tmin(q),
+                            count,
+                        },
+                    );
                 }
             }
         }
-        val
     }
 
     /// A direction toward a distant source: its centre, or with `-dj` a point jittered
@@ -1854,6 +1985,18 @@ impl Tracer {
     /// Irradiance at the first opaque surface along a ray (rtrace `-i`): glass, illum and
     /// straight-transmitting surfaces are passed; an emitter or the sky gives its radiance.
     pub fn irradiance_at_hit(&self, ray_index: u64, org: DVec3, dir: DVec3) -> [f64; 3] {
+        self.irradiance_at_hit_with(&mut self.direct_state(), ray_index, org, dir)
+    }
+
+    /// As [`irradiance_at_hit`](Self::irradiance_at_hit) with a source-thresholding state
+    /// (see [`radiance_with`](Self::radiance_with)).
+    pub fn irradiance_at_hit_with(
+        &self,
+        st: &mut DirectState,
+        ray_index: u64,
+        org: DVec3,
+        dir: DVec3,
+    ) -> [f64; 3] {
         let d = dir.normalize_or_zero();
         if d == DVec3::ZERO {
             return [0.0; 3];
@@ -1862,7 +2005,7 @@ impl Tracer {
         let mut skip = None;
         for _ in 0..100 {
             let Some(h) = self.accel.closest(o, d, Self::tmin(o), f64::INFINITY, skip) else {
-                return self.radiance(ray_index, o, d);
+                return self.radiance_with(st, ray_index, o, d);
             };
             let p = o + d * h.t;
             let mut n = self.accel.shapes[h.shape].normal(p);
@@ -1875,12 +2018,12 @@ impl Tracer {
                     o = p;
                     skip = self.accel.shapes[h.shape].is_flat().then_some(h.shape);
                 }
-                Material::Light { .. } => return self.radiance(ray_index, o, d),
+                Material::Light { .. } => return self.radiance_with(st, ray_index, o, d),
                 _ => {
                     if n.dot(d) > 0.0 {
                         n = -n;
                     }
-                    return self.irradiance(ray_index, p, n);
+                    return self.irradiance_with(st, ray_index, p, n);
                 }
             }
         }
@@ -1926,6 +2069,7 @@ mod tests {
                 rays: 0,
                 tracked: &[],
                 sink: None,
+                ds: None,
             };
             let draw = |i: usize, j: usize, cx: &mut Ctx| {
                 DVec3::splat(truth(i, j) * 2.0 * cx.rng.next_f64())

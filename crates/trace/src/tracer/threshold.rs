@@ -1,0 +1,597 @@
+//! Source thresholding (rtrace `-dt`/`-dc`), after Radiance's `direct()` as its source
+//! and documentation describe it (own code):
+//!
+//! 1. Every source sample is given its potential contribution — the BSDF coefficient times
+//!    the source's radiance, as if nothing were in the way — except samples that a
+//!    cached obstructor provably blocks (counted as a failed shadow test of their source).
+//! 2. Samples are sorted by the brightness of that potential, brightest first.
+//! 3. They are shadow-tested in that order; after the first [`MIN_TESTS`], testing stops
+//!    when the next ⌊n^dc + ½⌋ potentials together (n = number of samples) are below
+//!    `dt / weight` times the brightness of what the ray has gathered so far.
+//! 4. Each untested sample is added with its potential times an estimated visibility:
+//!    its source's hit rate so far (hits / tests, starting at 1/2) scaled by how this
+//!    point's tested samples did against their sources' rates.
+//!
+//! Radiance keeps the hit counts and its obstructor caches for the whole run, so its
+//! results depend on the order of the input rays and on its processes. fenestra keeps
+//! them in a [`DirectState`] that rtrace starts afresh for every block of consecutive
+//! input records and that one thread uses in input order: the output is the same for
+//! any number of threads.
+
+use super::*;
+
+/// Shadow tests always made before the threshold applies (Radiance's MINSHADCNT).
+pub(super) const MIN_TESTS: usize = 2;
+/// Obstructor cache resolution (cells per side of a cube face; Radiance's SHADCACHE).
+const RES: usize = 20;
+/// Sources after this many get an empty obstructor cache instead of a pre-cast one
+/// (Radiance's MAX2SHADE), bounding the set-up cost.
+const MAX_PRECAST: usize = 200;
+
+/// Photopic brightness of an RGB colour (Radiance's default primaries).
+fn bright(c: DVec3) -> f64 {
+    0.265074126 * c.x + 0.670114631 * c.y + 0.064811243 * c.z
+}
+
+/// One source sample seen from a point.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct SourceSample {
+    /// Unit direction toward the sample.
+    pub l: DVec3,
+    /// Solid angle it stands for.
+    pub omega: f64,
+    /// Shadow-ray length.
+    pub tmax: f64,
+    /// Samples drawn for its source from this point.
+    pub count: usize,
+}
+
+/// A sample with a potential contribution.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Candidate {
+    si: usize,
+    l: DVec3,
+    tmax: f64,
+    coef: DVec3,
+    val: DVec3,
+    brt: f32,
+    single: bool,
+}
+
+/// Hit statistics and obstructor caches of source thresholding, carried from one input
+/// ray to the next (see the module documentation).
+#[derive(Debug, Clone, Default)]
+pub struct DirectState {
+    ntests: Vec<u64>,
+    nhits: Vec<u64>,
+    /// Per source: its cache once changed (else the tracer's initial one).
+    cache: Vec<Option<Vec<u32>>>,
+    cands: Vec<Candidate>,
+    tail: Vec<f32>,
+}
+
+impl DirectState {
+    fn rate(&self, si: usize) -> f64 {
+        self.nhits[si] as f64 / self.ntests[si] as f64
+    }
+}
+
+/// Where one source's obstructor cells lie: each cell holds the surface that last
+/// blocked a shadow ray toward the source through that cell (0 = none, else index + 1).
+#[derive(Debug, Clone)]
+pub(super) enum CacheGeom {
+    /// A sphere: a cube map of directions from its centre.
+    Round { c: DVec3, r: f64 },
+    /// A flat source: the front half of a cube map in its frame (a, b, normal n).
+    Flat {
+        c: DVec3,
+        a: DVec3,
+        b: DVec3,
+        n: DVec3,
+        reach: f64,
+    },
+    /// A distant source (unit direction s): a grid across the scene's bounding sphere
+    /// (centre c, radius r), perpendicular to s.
+    Distant {
+        s: DVec3,
+        a: DVec3,
+        b: DVec3,
+        c: DVec3,
+        r: f64,
+    },
+}
+
+/// A source's obstructor cache as the scene alone gives it (before any ray).
+#[derive(Debug, Clone)]
+pub(super) struct ObsCache {
+    geom: CacheGeom,
+    cells: Vec<u32>,
+}
+
+/// Cell of a coordinate in [-1, 1] at `n` cells. The scale is a hair under n/2 so that
+/// a coordinate on a cell boundary (as 0.5 is) goes to the lower cell, as in Radiance:
+/// the caches then agree on which surface a cell holds.
+fn bin(x: f64, n: usize) -> usize {
+    ((n as f64 * (0.5 - 1e-6) * (1.0 + x)).max(0.0) as usize).min(n - 1)
+}
+
+/// Centre of cell `i` of `n` over [-1, 1].
+fn centre(i: usize, n: usize) -> f64 {
+    (i as f64 + 0.5) / n as f64 * 2.0 - 1.0
+}
+
+impl CacheGeom {
+    fn len(&self) -> usize {
+        match self {
+            CacheGeom::Round { .. } => 6 * RES * RES,
+            CacheGeom::Flat { .. } => RES * RES + 4 * (RES / 2) * RES,
+            CacheGeom::Distant { .. } => 4 * RES * RES,
+        }
+    }
+
+    /// The cell of a shadow ray starting at `p` with unit direction `l` (toward the
+    /// source). A sphere's cells are indexed by `l` (the largest component, ties to the
+    /// last axis, and the other two over it), a flat source's by `-l` in its frame.
+    fn cell(&self, p: DVec3, l: DVec3) -> Option<usize> {
+        match self {
+            CacheGeom::Round { .. } => {
+                let m = l.abs();
+                let mut ax = 2;
+                for k in [1, 0] {
+                    if m[k] > m[ax] {
+                        ax = k;
+                    }
+                }
+                if m[ax] <= 0.0 {
+                    return None;
+                }
+                let face = 2 * ax + usize::from(l[ax] < 0.0);
+                let x = l[(ax + 1) % 3] / m[ax];
+                let y = l[(ax + 2) % 3] / m[ax];
+                Some(face * RES * RES + bin(x, RES) * RES + bin(y, RES))
+            }
+            CacheGeom::Flat { a, b, n, .. } => {
+                let u = -l;
+                let (x, y, z) = (u.dot(*a), u.dot(*b), u.dot(*n));
+                if z <= 0.0 {
+                    return None;
+                }
+                let (mx, my) = (x.abs(), y.abs());
+                if z >= mx && z >= my {
+                    return Some(bin(x / z, RES) * RES + bin(y / z, RES));
+                }
+                let half = RES / 2;
+                let (side, main, other) = if mx >= my {
+                    (usize::from(x < 0.0), mx, y)
+                } else {
+                    (2 + usize::from(y < 0.0), my, x)
+                };
+                // 0 next to the front face's edge, half - 1 at the horizon
+                let k = bin(-z / main, RES).min(half - 1);
+                Some(RES * RES + side * half * RES + k * RES + bin(other / main, RES))
+            }
+            CacheGeom::Distant { a, b, c, r, .. } => {
+                let d = p - *c;
+                let m = 2 * RES;
+                let x = (d.dot(*a) + r) / (2.0 * r) * m as f64;
+                let y = (d.dot(*b) + r) / (2.0 * r) * m as f64;
+                if !(0.0..m as f64).contains(&x) || !(0.0..m as f64).contains(&y) {
+                    return None;
+                }
+                Some(x as usize * m + y as usize)
+            }
+        }
+    }
+
+    /// Rays cast from the source outward, one through the middle of every cell.
+    fn casts(&self) -> Vec<(DVec3, DVec3)> {
+        let mut out = Vec::with_capacity(self.len());
+        match self {
+            CacheGeom::Round { c, r } => {
+                for ax in 0..3 {
+                    for sign in [1.0, -1.0] {
+                        for i in 0..RES {
+                            for j in 0..RES {
+                                let mut u = DVec3::ZERO;
+                                u[ax] = sign;
+                                u[(ax + 1) % 3] = centre(i, RES);
+                                u[(ax + 2) % 3] = centre(j, RES);
+                                let u = u.normalize();
+                                out.push((*c + u * (1.05 * r), u));
+                            }
+                        }
+                    }
+                }
+            }
+            CacheGeom::Flat { c, a, b, n, reach } => {
+                let o = *c + *n * (0.01 * reach);
+                for i in 0..RES {
+                    for j in 0..RES {
+                        let u = *a * centre(i, RES) + *b * centre(j, RES) + *n;
+                        out.push((o, u.normalize()));
+                    }
+                }
+                let half = RES / 2;
+                for (main, other) in [(*a, *b), (-*a, *b), (*b, *a), (-*b, *a)] {
+                    for k in 0..half {
+                        for j in 0..RES {
+                            let z = (k as f64 + 0.5) / half as f64;
+                            let u = main + other * centre(j, RES) + *n * z;
+                            out.push((o, u.normalize()));
+                        }
+                    }
+                }
+            }
+            CacheGeom::Distant { s, a, b, c, r } => {
+                let m = 2 * RES;
+                for i in 0..m {
+                    for j in 0..m {
+                        let o =
+                            *c + *a * (centre(i, m) * r) + *b * (centre(j, m) * r) + *s * (2.0 * r);
+                        out.push((o, -*s));
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
+impl Tracer {
+    /// Whether rtrace should carry a [`DirectState`] from ray to ray: `-dt > 0` and
+    /// light sources that can give more than [`MIN_TESTS`] samples at a point.
+    pub fn thresholding(&self) -> bool {
+        self.obs.is_some()
+    }
+
+    /// A fresh thresholding state (every source at a 1/2 hit rate, initial caches).
+    pub fn direct_state(&self) -> DirectState {
+        let n = if self.thresholding() {
+            self.sources.len()
+        } else {
+            0
+        };
+        DirectState {
+            ntests: vec![2; n],
+            nhits: vec![1; n],
+            cache: vec![None; n],
+            cands: Vec::new(),
+            tail: Vec::new(),
+        }
+    }
+
+    /// Whether thresholding applies to this scene and these options.
+    pub(super) fn wants_threshold(opts: &TraceOptions, sources: &[Source]) -> bool {
+        opts.dt > 0.0
+            && (sources.len() > MIN_TESTS
+                || sources
+                    .iter()
+                    .any(|s| matches!(s.geom, SourceGeom::Local(_))))
+    }
+
+    /// The initial obstructor cache of every source (None: not cached — virtual sources,
+    /// glows with a radius, spotlights — or beyond [`MAX_PRECAST`]: empty).
+    pub(super) fn build_caches(&self) -> Vec<Option<ObsCache>> {
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        for s in &self.accel.shapes {
+            let (a, b) = s.bounds();
+            lo = lo.min(a);
+            hi = hi.max(b);
+        }
+        let (bc, br) = if lo.x <= hi.x {
+            ((lo + hi) * 0.5, ((hi - lo).length() * 0.5).max(1e-6) * 1.01)
+        } else {
+            (DVec3::ZERO, 1.0)
+        };
+        self.sources
+            .iter()
+            .enumerate()
+            .map(|(si, s)| {
+                let plain = match &self.mats[&s.mat] {
+                    Material::Light { kind, .. } => match kind {
+                        LightKind::Glow(r) => !r.is_finite() || *r <= 0.0,
+                        LightKind::Spot(..) => false,
+                        _ => true,
+                    },
+                    _ => false,
+                };
+                if !plain {
+                    return None;
+                }
+                let geom = match s.geom {
+                    SourceGeom::Virtual { .. } => return None,
+                    SourceGeom::Distant(k) => {
+                        let d = self.distant[k].dir;
+                        let (a, b) = frame(d);
+                        CacheGeom::Distant {
+                            s: d,
+                            a,
+                            b,
+                            c: bc,
+                            r: br,
+                        }
+                    }
+                    SourceGeom::Local(sh) => match &self.accel.shapes[sh] {
+                        Shape::Sphere { c, r, .. } => CacheGeom::Round { c: *c, r: *r },
+                        Shape::Polygon(poly) => {
+                            let c = poly.centroid();
+                            let reach = poly
+                                .verts
+                                .iter()
+                                .map(|v| (*v - c).length())
+                                .fold(0.0, f64::max);
+                            let (a, b) = frame(poly.normal);
+                            CacheGeom::Flat {
+                                c,
+                                a,
+                                b,
+                                n: poly.normal,
+                                reach,
+                            }
+                        }
+                        Shape::Ring { c, n, r1, .. } => {
+                            let (a, b) = frame(*n);
+                            CacheGeom::Flat {
+                                c: *c,
+                                a,
+                                b,
+                                n: *n,
+                                reach: *r1,
+                            }
+                        }
+                        Shape::Cone { .. } => return None,
+                    },
+                };
+                let mut cells = vec![0u32; geom.len()];
+                if si < MAX_PRECAST {
+                    for (o, u) in geom.casts() {
+                        if let (Some(b), Some(k)) = (self.first_blocker(o, u), geom.cell(o, -u)) {
+                            cells[k] = b as u32 + 1;
+                        }
+                    }
+                }
+                Some(ObsCache { geom, cells })
+            })
+            .collect()
+    }
+
+    /// The first surface along a ray that is a reliable blocker (skipping others).
+    fn first_blocker(&self, o: DVec3, u: DVec3) -> Option<usize> {
+        let mut t0 = Self::tmin(o);
+        for _ in 0..64 {
+            let h = self.accel.closest(o, u, t0, f64::INFINITY, None)?;
+            if self.blocker[h.shape] {
+                return Some(h.shape);
+            }
+            t0 = h.t + 1e-6 * (1.0 + h.t);
+        }
+        None
+    }
+
+    /// Whether the cached obstructor of source `si` blocks the shadow ray from `p` along
+    /// `l` before it reaches the source (at `tsrc`).
+    fn cache_blocks(
+        &self,
+        st: &DirectState,
+        si: usize,
+        p: DVec3,
+        l: DVec3,
+        tsrc: f64,
+        skip: Option<usize>,
+    ) -> bool {
+        let Some(Some(oc)) = self.obs.as_ref().map(|o| &o[si]) else {
+            return false;
+        };
+        let Some(k) = oc.geom.cell(p, l) else {
+            return false;
+        };
+        let cells = st.cache[si].as_deref().unwrap_or(&oc.cells);
+        let b = cells[k];
+        if b == 0 || Some(b as usize - 1) == skip || self.own_emitter(si, b as usize - 1) {
+            return false;
+        }
+        self.accel.shapes[b as usize - 1]
+            .intersect(p, l, Self::tmin(p), tsrc)
+            .is_some()
+    }
+
+    /// Whether shape `b` emits with source `si`'s material (not a blocker of that source).
+    fn own_emitter(&self, si: usize, b: usize) -> bool {
+        self.surf_mat[b] == self.sources[si].mat
+    }
+
+    /// Records the surface that blocked a failed shadow test of source `si` in its cache.
+    fn record_blocker(
+        &self,
+        st: &mut DirectState,
+        si: usize,
+        p: DVec3,
+        l: DVec3,
+        tmax: f64,
+        skip: Option<usize>,
+    ) {
+        let Some(Some(oc)) = self.obs.as_ref().map(|o| &o[si]) else {
+            return;
+        };
+        let Some(k) = oc.geom.cell(p, l) else {
+            return;
+        };
+        let Some(h) = self.accel.closest(p, l, Self::tmin(p), tmax, skip) else {
+            return;
+        };
+        if self.blocker[h.shape] && !self.own_emitter(si, h.shape) {
+            st.cache[si].get_or_insert_with(|| oc.cells.clone())[k] = h.shape as u32 + 1;
+        }
+    }
+
+    /// Radiance a shadow ray `c` (aimed at source `si`) would bring if nothing were in
+    /// the way, and where it meets the source (`tsrc`, for the cache test).
+    fn potential(&self, c: &Ray, si: usize, cx: &mut Ctx) -> (DVec3, f64) {
+        let s = &self.sources[si];
+        let tmin = Self::tmin(c.org);
+        match s.geom {
+            SourceGeom::Distant(k) => {
+                let d = &self.distant[k];
+                let v = self.shade_light(c, d.mat, 1.0, f64::INFINITY, DVec3::ZERO, None, cx);
+                (v.0, f64::INFINITY)
+            }
+            SourceGeom::Local(sh) => {
+                let shp = &self.accel.shapes[sh];
+                match shp.intersect(c.org, c.dir, tmin, f64::INFINITY) {
+                    Some(t) => {
+                        let q = c.org + c.dir * t;
+                        let rod = -c.dir.dot(shp.normal(q));
+                        (self.shade_light(c, s.mat, rod, t, q, Some(sh), cx).0, t)
+                    }
+                    None => (DVec3::ZERO, c.tmax),
+                }
+            }
+            SourceGeom::Virtual { base, mirror, .. } => {
+                let shp = &self.accel.shapes[mirror];
+                let Some(t) = shp.intersect(c.org, c.dir, tmin, f64::INFINITY) else {
+                    return (DVec3::ZERO, f64::INFINITY);
+                };
+                let (Material::Mirror { color }, SourceGeom::Distant(k)) =
+                    (&self.mats[&self.surf_mat[mirror]], self.sources[base].geom)
+                else {
+                    return (DVec3::ZERO, f64::INFINITY);
+                };
+                let q = c.org + c.dir * t;
+                let n = shp.normal(q);
+                let rod = -c.dir.dot(n);
+                let nrm = if rod < 0.0 { -n } else { n };
+                let d = &self.distant[k];
+                if d.dir.dot(nrm) <= 0.0 {
+                    return (DVec3::ZERO, f64::INFINITY);
+                }
+                let mut rc = c.clone();
+                rc.org = q;
+                rc.dir = (c.dir + nrm * (2.0 * rod.abs())).normalize();
+                rc.src = Some(base);
+                let v = self.shade_light(&rc, d.mat, 1.0, f64::INFINITY, DVec3::ZERO, None, cx);
+                (*color * v.0, f64::INFINITY)
+            }
+        }
+    }
+
+    /// [`Tracer::direct`] with thresholding (see the module documentation).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn direct_threshold(
+        &self,
+        r: &Ray,
+        p: DVec3,
+        nrm: DVec3,
+        shape: Option<usize>,
+        prior: DVec3,
+        cx: &mut Ctx,
+        bsdf: impl Fn(DVec3, f64, f64) -> DVec3,
+    ) -> DVec3 {
+        let skip = shape.filter(|&s| self.accel.shapes[s].is_flat());
+        let Some(st) = cx.ds.as_deref_mut() else {
+            return DVec3::ZERO;
+        };
+        let mut cands = std::mem::take(&mut st.cands);
+        let mut tail = std::mem::take(&mut st.tail);
+        cands.clear();
+        for si in 0..self.sources.len() {
+            self.each_sample(si, p, shape, cx, |cx, s| {
+                let mut c = self.child(r, p, s.l, SHADOW, DVec3::ONE, skip, 0.0);
+                c.weight = r.weight;
+                c.src = Some(si);
+                c.tmax = s.tmax;
+                let (pot, tsrc) = self.potential(&c, si, cx);
+                let single = s.count == 1;
+                let Some(st) = cx.ds.as_deref_mut() else {
+                    return;
+                };
+                if single && self.cache_blocks(st, si, p, s.l, tsrc.min(s.tmax), skip) {
+                    st.ntests[si] += 1;
+                    return;
+                }
+                let coef = bsdf(s.l, s.omega, s.l.dot(nrm));
+                if maxc(coef) <= 0.0 {
+                    return;
+                }
+                let val = coef * pot;
+                let brt = bright(val) as f32;
+                if brt > 0.0 {
+                    cands.push(Candidate {
+                        si,
+                        l: s.l,
+                        tmax: s.tmax,
+                        coef,
+                        val,
+                        brt,
+                        single,
+                    });
+                }
+            });
+        }
+        // brightest first; equal ones in source order (a stable sort)
+        cands.sort_by(|a, b| b.brt.total_cmp(&a.brt));
+        let n = cands.len();
+        tail.clear();
+        tail.resize(n + 1, 0.0);
+        for k in (0..n).rev() {
+            tail[k] = tail[k + 1] + cands[k].brt;
+        }
+        let check = ((n as f64).powf(self.opts.dc) + 0.5) as usize;
+        let thresh = self.opts.dt / r.weight;
+        let mut gathered = prior;
+        let mut total = DVec3::ZERO;
+        let (mut hits, mut expected) = (0u64, 0.0f64);
+        let mut tested = 0;
+        while tested < n {
+            let k = tested;
+            if k >= MIN_TESTS {
+                let rest = if k + check >= n {
+                    tail[k]
+                } else {
+                    tail[k] - tail[k + check]
+                };
+                if (rest as f64) < thresh * bright(gathered) {
+                    break;
+                }
+            }
+            let cd = cands[k];
+            if let Some(st) = cx.ds.as_deref_mut() {
+                st.ntests[cd.si] += 1;
+            }
+            let mut c = self.child(r, p, cd.l, SHADOW, cd.coef, skip, 0.0);
+            c.weight = r.weight;
+            c.src = Some(cd.si);
+            c.tmax = cd.tmax;
+            let v = self.trace(&c, cx);
+            let Some(st) = cx.ds.as_deref_mut() else {
+                break;
+            };
+            if (v.x + v.y + v.z) / 3.0 > FTINY {
+                let val = cd.coef * v;
+                total += val;
+                gathered += val;
+                hits += 1;
+                st.nhits[cd.si] += 1;
+            } else if cd.single {
+                self.record_blocker(st, cd.si, p, cd.l, cd.tmax, skip);
+            }
+            expected += st.rate(cd.si);
+            tested += 1;
+        }
+        if let Some(st) = cx.ds.as_deref_mut() {
+            // untested samples: potential times the source's hit rate, scaled by how
+            // this point's tests did against their sources' rates
+            let scale = if expected > FTINY {
+                hits as f64 / expected
+            } else {
+                0.5
+            };
+            for cd in &cands[tested..] {
+                let prob = scale * st.rate(cd.si);
+                total += if prob < 1.0 { cd.val * prob } else { cd.val };
+            }
+            st.cands = cands;
+            st.tail = tail;
+        }
+        total
+    }
+}

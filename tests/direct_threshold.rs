@@ -1,0 +1,210 @@
+//! rtrace `-dt`/`-dc` (source thresholding): only the brightest source samples are
+//! shadow-tested, the rest are added with an estimated visibility. Checked against the
+//! reference rtrace on a scene of 60 lamps and 20 partitions (tests/fixtures/direct_threshold).
+
+mod common;
+
+use std::path::Path;
+
+const FIXTURE: &str = "direct_threshold";
+
+fn points() -> String {
+    std::fs::read_to_string(common::fixture(FIXTURE).join("points.txt")).unwrap()
+}
+
+/// The first value (red) of every record.
+fn reds(v: &[f64]) -> Vec<f64> {
+    v.chunks(3).map(|c| c[0]).collect()
+}
+
+fn worst_rel(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| {
+            let d = (x / y - 1.0).abs();
+            assert!(d.is_finite(), "{x} {y}");
+            d
+        })
+        .fold(0.0, f64::max)
+}
+
+fn total_rel(a: &[f64], b: &[f64]) -> f64 {
+    (a.iter().sum::<f64>() / b.iter().sum::<f64>() - 1.0).abs()
+}
+
+/// Runs both tools on `scene.rad` in `dir` with `-h -I+ -ab 0` and `opts` over `rays`;
+/// returns (theirs, ours) per point (red channel).
+fn both(oracle: &common::Oracle, dir: &Path, opts: &str, rays: &str) -> (Vec<f64>, Vec<f64>) {
+    let mut all = vec!["-h", "-I+", "-ab", "0"];
+    all.extend(opts.split_whitespace());
+    let (t, o) = common::both_rtrace(oracle, dir, &all, rays);
+    (reds(&t), reds(&o))
+}
+
+// Tolerance: with -dt 0 (every sample tested) the two tools differ on this scene by
+// 8e-5 to 9.8e-5 per point (measured), all from the sphere sources' solid angle (fenestra
+// the exact cone 2π(1 − cos), Radiance πr²/d²). With thresholding, the same order of input
+// records and the same -dt/-dc, the measured worst is 1.03e-4 per point and 9.4e-5 in the
+// total (five -dt/-dc settings, five input orders). 3e-4 per point and 2e-4 in the total
+// leave room for that offset and rounding while staying far below what is tested: the
+// thresholding effect itself (oracle -dt .03 against its -dt 0: up to 2.6% per point, up
+// to 30% with -dt .3) and the oracle's own spread between input orders (up to 0.93% per
+// point), both asserted or measured below.
+const PER_POINT: f64 = 3e-4;
+const TOTAL: f64 = 2e-4;
+
+/// Runs the settings on a scene folder holding `scene.rad`; checks agreement and that
+/// thresholding changed the oracle's values by at least `min_effect` at some point.
+fn agree(oracle: &common::Oracle, dir: &Path, rays: &str, min_effect: f64) {
+    let (base, ours0) = both(oracle, dir, "-dt 0", rays);
+    let w = worst_rel(&ours0, &base);
+    assert!(w < PER_POINT, "-dt 0: worst {w:.2e}");
+    for opts in ["-dt .03", "-dt .1 -dc .5", "-dt .3 -dc 0", "-dt .05 -dc 1"] {
+        let (t, o) = both(oracle, dir, opts, rays);
+        let effect = worst_rel(&t, &base);
+        assert!(
+            effect > min_effect,
+            "{opts}: the oracle's thresholding effect {effect:.4} is too small for this test"
+        );
+        assert!(
+            worst_rel(&o, &ours0) > min_effect,
+            "{opts}: fenestra did not threshold"
+        );
+        let (w, tot) = (worst_rel(&o, &t), total_rel(&o, &t));
+        assert!(
+            w < PER_POINT && tot < TOTAL,
+            "{opts}: worst point {w:.2e}, total {tot:.2e} (oracle effect {effect:.4})"
+        );
+    }
+}
+
+#[test]
+fn oracle_thresholding_with_the_obstructor_cache() {
+    let Some(oracle) = common::oracle() else {
+        return;
+    };
+    let dir = common::scratch("dt_cache");
+    std::fs::copy(
+        common::fixture(FIXTURE).join("scene.rad"),
+        dir.join("scene.rad"),
+    )
+    .unwrap();
+    agree(&oracle, &dir, &points(), 0.01);
+    // the statistics follow the order of the records: reversed input, same agreement
+    let rev: String = points().lines().rev().map(|l| format!("{l}\n")).collect();
+    let (t, o) = both(&oracle, &dir, "-dt .03", &rev);
+    let (w, tot) = (worst_rel(&o, &t), total_rel(&o, &t));
+    assert!(w < PER_POINT && tot < TOTAL, "reversed: {w:.2e} {tot:.2e}");
+    // ...while the oracle itself moves by more than that between the two orders
+    let (fwd, _) = both(&oracle, &dir, "-dt .03", &points());
+    let back: Vec<f64> = t.into_iter().rev().collect();
+    let spread = worst_rel(&back, &fwd);
+    assert!(
+        spread > 10.0 * PER_POINT,
+        "oracle order spread {spread:.2e}"
+    );
+}
+
+#[test]
+fn oracle_thresholding_without_the_obstructor_cache() {
+    // `trans` walls of zero transmission stop shadow rays but are not an opaque type:
+    // neither tool caches them, so this checks the ordering, threshold and hit statistics
+    let Some(oracle) = common::oracle() else {
+        return;
+    };
+    let dir = common::scratch("dt_nocache");
+    let scene = std::fs::read_to_string(common::fixture(FIXTURE).join("scene.rad")).unwrap();
+    let plastic = "void plastic wall_m 0 0 5 .5 .5 .5 0 0";
+    assert!(scene.contains(plastic));
+    let scene = scene.replace(plastic, "void trans wall_m 0 0 7 .5 .5 .5 0 0 0 0");
+    std::fs::write(dir.join("scene.rad"), scene).unwrap();
+    agree(&oracle, &dir, &points(), 0.005);
+}
+
+fn run(dir: &Path, opts: &[&str], rays: &str) -> (Vec<u8>, String) {
+    let mut c = common::fenestra("rtrace");
+    c.args(opts).arg("scene.rad").current_dir(dir);
+    let out = common::run_stdin(c, rays.as_bytes());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (
+        out.stdout,
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn thresholded_output_is_the_same_for_any_thread_count() {
+    let dir = common::fixture(FIXTURE);
+    // 300 records: several blocks of statistics (a block is 64 records)
+    let mut rays = String::new();
+    for k in 0..10 {
+        for l in points().lines() {
+            let v: Vec<f64> = l.split_whitespace().map(|w| w.parse().unwrap()).collect();
+            rays.push_str(&format!(
+                "{} {} {} 0 0 1\n",
+                v[0] + 0.013 * k as f64,
+                v[1],
+                v[2]
+            ));
+        }
+    }
+    // radiance of the floor and walls seen looking down
+    let down = rays.replace(" 0 0 1\n", " 0.3 0.2 -1\n");
+    for (opts, rays) in [
+        (&["-h", "-I+", "-ab", "0"][..], &rays),
+        (
+            &["-h", "-I+", "-ab", "1", "-ad", "16", "-dj", ".5"][..],
+            &rays,
+        ),
+        (
+            &["-h", "-ab", "1", "-ad", "8", "-dt", ".1", "-dc", ".5"][..],
+            &down,
+        ),
+    ] {
+        let one = run(&dir, &[opts, &["-n", "1"]].concat(), rays).0;
+        for n in ["2", "3"] {
+            let many = run(&dir, &[opts, &["-n", n]].concat(), rays).0;
+            assert!(one == many, "{opts:?}: -n {n} differs from -n 1");
+        }
+        let full = run(&dir, &[opts, &["-dt", "0"]].concat(), rays).0;
+        assert!(one != full, "{opts:?}: thresholding changed nothing");
+        assert_eq!(common::numbers(&one).len(), common::numbers(&full).len());
+    }
+}
+
+#[test]
+fn verbose_says_when_thresholding_is_on() {
+    let dir = common::fixture(FIXTURE);
+    let rays = points();
+    let (_, err) = run(&dir, &["-h", "-I+", "-v"], &rays);
+    assert!(
+        err.contains("source thresholding: on (-dt 0.03 -dc 0.75, 60 source(s))"),
+        "{err}"
+    );
+    assert!(err.contains("every 64 input records"), "{err}");
+    let (_, err0) = run(&dir, &["-h", "-I+", "-v", "-dt", "0"], &rays);
+    assert!(err0.contains("source thresholding: off (-dt 0)"), "{err0}");
+    // the shadow rays saved are visible in the ray count
+    let count = |e: &str| -> u64 {
+        let l = e.lines().find(|l| l.contains("rays traced")).unwrap();
+        l.split_whitespace().nth(1).unwrap().parse().unwrap()
+    };
+    assert!(count(&err) < count(&err0) / 2, "{err}\n{err0}");
+    // one distant source: at most one sample per point, nothing to threshold
+    let sun = common::scratch("dt_sun");
+    std::fs::write(
+        sun.join("scene.rad"),
+        "void light solar 0 0 3 1e6 1e6 1e6\nsolar source sun 0 0 4 0 0 1 0.5\n\
+         void plastic gray 0 0 5 .5 .5 .5 0 0\ngray polygon floor 0 0 12 -5 -5 0 5 -5 0 5 5 0 -5 5 0\n",
+    )
+    .unwrap();
+    let (_, err1) = run(&sun, &["-h", "-I+", "-v"], "0 0 1 0 0 1\n");
+    assert!(
+        err1.contains("source thresholding: off (-dt 0.03, but at most 2 source samples"),
+        "{err1}"
+    );
+}
