@@ -128,9 +128,10 @@ fn report(
         comp(Direction::TransmissionBack),
         comp(Direction::TransmissionFront),
     );
-    // Radiance drops a tree component whose largest directional total, its Lambertian part
-    // removed, is at most 0.001; the split-off part still prints (as a missing transmission's).
-    let dropped = |c: &ComponentCheck| tree && c.max_total - c.lambertian_xyz[1] <= 0.001;
+    // Radiance drops a component whose largest directional total, its Lambertian part removed,
+    // is at most 0.001; the split-off part still prints (as a missing transmission's).
+    let dropped = |c: &ComponentCheck| c.max_total - c.lambertian_xyz[1] <= 0.001;
+    let kept = |c: &Option<ComponentCheck>| c.as_ref().is_some_and(|c| !dropped(c));
     let all_dropped = [&rf, &rb, &tf, &tb]
         .iter()
         .all(|c| c.as_ref().is_none_or(dropped));
@@ -146,7 +147,7 @@ fn report(
         cm(b.height),
         cm(b.thickness)
     )?;
-    let kind = if tree && all_dropped {
+    let kind = if all_dropped {
         "Pure_Lambertian".to_string()
     } else {
         data_type(b)
@@ -263,18 +264,19 @@ fn report(
         rec(
             &mut s,
             "Interior Refl",
-            check::reflection_reciprocity(b, Direction::ReflectionBack),
+            check::reflection_reciprocity(b, Direction::ReflectionBack).filter(|_| kept(&rf)),
         );
         rec(
             &mut s,
             "Exterior Refl",
-            check::reflection_reciprocity(b, Direction::ReflectionFront),
+            check::reflection_reciprocity(b, Direction::ReflectionFront).filter(|_| kept(&rb)),
         );
         let lamb = |c: &Option<ComponentCheck>| c.as_ref().map_or(0.0, |c| c.lambertian_y);
         rec(
             &mut s,
             "Transmission",
-            check::transmission_reciprocity_with(b, lamb(&tb), lamb(&tf)),
+            check::transmission_reciprocity_with(b, lamb(&tb), lamb(&tf))
+                .filter(|_| kept(&tf) && kept(&tb)),
         );
     }
 
