@@ -53,8 +53,10 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         let b = fenestra_bsdf::read_file(&path).map_err(|e| anyhow!("{e}"))?;
         let colour = fenestra_bsdf::radiance::colour_lambertians(&b, &mut rng);
         let xml = std::fs::read_to_string(&path).map_err(|e| anyhow!("{}: {e}", path.display()))?;
-        let sampled = check::sampled::tree_rows(&xml, &b, &mut rng)
-            .map_err(|e| anyhow!("{}: {e}", path.display()))?;
+        let sampled = |totals| {
+            check::sampled::tree_rows(&xml, totals, &mut rng)
+                .map_err(|e| anyhow!("{}: {e}", path.display()))
+        };
         let text = report(f, &b, &colour, sampled)?;
         out.write_all(text.as_bytes())?;
         out.flush()?;
@@ -101,12 +103,13 @@ fn angle(a: f64) -> String {
 }
 
 /// The report for one file (`colour`: the coloured Lambertian parts split off on loading;
-/// `sampled`: the reciprocity rows of a grey tensor-tree file, from `check::sampled`).
+/// `sampled`: the reciprocity rows of a grey tensor-tree file, from `check::sampled`, given the
+/// components' largest directional totals).
 fn report(
     name: &str,
     b: &Bsdf,
     colour: &[(Direction, [f64; 3])],
-    sampled: Option<[SampledRow; 3]>,
+    sampled: impl FnOnce([Option<f64>; 4]) -> Result<Option<[SampledRow; 3]>>,
 ) -> Result<String> {
     let mut s = String::new();
     let tree = b
@@ -216,6 +219,12 @@ fn report(
             ),
             None => writeln!(s, "{label}\t  0\t  0\t  0"),
         };
+    };
+    let sampled = if tree {
+        let total = |c: &Option<ComponentCheck>| c.as_ref().map(|c| c.max_total);
+        sampled([total(&rf), total(&rb), total(&tf), total(&tb)])?
+    } else {
+        None
     };
     if let Some(rows) = sampled {
         // Grey tensor trees: Radiance's sampled rows, reproduced (check::sampled).

@@ -27,7 +27,7 @@
 use std::f64::consts::{FRAC_PI_4, PI};
 
 use crate::check::Reciprocity;
-use crate::model::{Bsdf, Direction};
+use crate::model::Direction;
 use crate::radiance::Drand48;
 
 /// Radiance's `FTINY`.
@@ -621,12 +621,14 @@ fn parse_tree(rank: usize, text: &str) -> Result<Node, String> {
 }
 
 /// Radiance's three reciprocity rows (Interior Refl, Exterior Refl, Transmission) for a
-/// grey tensor-tree file, drawing from `rng`. `xml` is the file's text, `b` the same file read
-/// (for the components Radiance drops as insignificant). `Ok(None)` for files this does not
-/// cover (Klems matrices, coloured trees: CIE-u/v blocks).
+/// grey tensor-tree file, drawing from `rng`. `xml` is the file's text; `max_totals` the largest
+/// directional totals of XML `Reflection Back`, `Reflection Front`, `Transmission Back` and
+/// `Transmission Front` as the component table gives them (Radiance drops a component with at
+/// most 0.001 left after its Lambertian part). `Ok(None)` for files this does not cover (Klems
+/// matrices, coloured trees: CIE-u/v blocks).
 pub fn tree_rows(
     xml: &str,
-    b: &Bsdf,
+    max_totals: [Option<f64>; 4],
     rng: &mut Drand48,
 ) -> Result<Option<[SampledRow; 3]>, String> {
     let root = crate::dom::parse(xml).map_err(|(m, p)| format!("{m} (byte {p})"))?;
@@ -693,15 +695,15 @@ pub fn tree_rows(
     }
     // Radiance drops components whose largest directional total (Lambertian part removed) is
     // at most 0.001.
-    let keep = |t: Option<Tree>, d: Direction, l: f64| {
-        t.filter(|_| crate::check::tree_component(b, d).is_some_and(|c| c.max_total - l > 0.001))
+    let keep = |t: Option<Tree>, k: usize, l: f64| {
+        t.filter(|_| max_totals[k].is_some_and(|m| m - l > 0.001))
     };
     let loaded = Loaded {
         rank,
-        rf: keep(rf, Direction::ReflectionBack, r_lamb_front),
-        rb: keep(rb, Direction::ReflectionFront, r_lamb_back),
-        tf: keep(tf, Direction::TransmissionBack, t_lamb_front),
-        tb: keep(tb, Direction::TransmissionFront, t_lamb_back),
+        rf: keep(rf, 0, r_lamb_front),
+        rb: keep(rb, 1, r_lamb_back),
+        tf: keep(tf, 2, t_lamb_front),
+        tb: keep(tb, 3, t_lamb_back),
         r_lamb_front,
         r_lamb_back,
         t_lamb_front,
@@ -732,7 +734,14 @@ mod tests {
 
     fn rows(xml: &str, rng: &mut Drand48) -> [SampledRow; 3] {
         let b = crate::read::parse(xml, "test.xml").unwrap();
-        tree_rows(xml, &b, rng).unwrap().unwrap()
+        let totals = [
+            Direction::ReflectionBack,
+            Direction::ReflectionFront,
+            Direction::TransmissionBack,
+            Direction::TransmissionFront,
+        ]
+        .map(|d| crate::check::tree_component(&b, d).map(|c| c.max_total));
+        tree_rows(xml, totals, rng).unwrap().unwrap()
     }
 
     /// Draws per first direction: 256 cells of 1/16 with one point each, and where leaves are
