@@ -684,3 +684,55 @@ fn oracle_zero_rules() {
     }
     assert_eq!(n, 28);
 }
+
+/// The oracle's rcalc reads our lib bin files (klems_full/half/quarter.cal, reinhart.cal)
+/// and gives the bins our rcalc gives with them, on every direction of the bin tables and
+/// their nudged copies: the files use only language the oracle evaluates the same way.
+#[test]
+fn oracle_rcalc_runs_our_bin_files() {
+    let Some(o) = common::oracle() else { return };
+    let mut cases = Vec::new();
+    for (file, f, table_name) in [
+        ("klems_full.cal", "kbin", "klems/klems_full_bins.tsv"),
+        ("klems_half.cal", "khbin", "klems/klems_half_bins.tsv"),
+        ("klems_quarter.cal", "kqbin", "klems/klems_quarter_bins.tsv"),
+    ] {
+        let prog = format!(
+            "Dx=$1;Dy=$2;Dz=$3;$1={f}(0,0,1,0,1,0);$2={f}(0,0,-1,0,1,0);$3={f}(0,1,0,0,0,1);$4={f}(-1,0,0,0,0,1);$5={f}(0.6,0,0.8,0.1,1,0.3)"
+        );
+        cases.push((table_name.to_string(), 1, String::new(), file, prog));
+        let lh = format!("Dx=$1;Dy=$2;Dz=$3;$1={f}(0,0,1,0,1,0)");
+        cases.push((table_name.to_string(), 1, "RHS=-1".to_string(), file, lh));
+    }
+    for mf in [1, 2, 4] {
+        cases.push((
+            format!("rcalc/reinhart{mf}_rbin.tsv"),
+            0,
+            format!("MF:{mf}"),
+            "reinhart.cal",
+            "Dx=$1;Dy=$2;Dz=$3;$1=rbin;$2=Nrbins".to_string(),
+        ));
+    }
+    for (table_name, dx, pre, file, prog) in &cases {
+        let rows = table(&common::fixture(table_name));
+        let input = dirs_input(&rows, *dx);
+        let path = lib().join(file);
+        let path = path.to_str().unwrap();
+        let mut args = Vec::new();
+        if !pre.is_empty() {
+            args.extend(["-e", pre.as_str()]);
+        }
+        args.extend(["-f", path, "-e", prog.as_str()]);
+        let mut oc = o.command("rcalc");
+        oc.args(&args);
+        let (ook, oout, oerr) = run_with(oc, input.as_bytes());
+        assert!(ook, "{oerr}");
+        let (fok, fout, ferr) = run_with(ours(&args), input.as_bytes());
+        assert!(fok, "{ferr}");
+        assert_eq!(oout.lines().count(), 7 * rows.len(), "{file} {pre}");
+        for (i, (a, b)) in oout.lines().zip(fout.lines()).enumerate() {
+            assert_eq!(a, b, "{file} {pre}: input line {i}");
+        }
+        eprintln!("{file} {pre}: {} lines agree", 7 * rows.len());
+    }
+}

@@ -25,7 +25,10 @@ fn dirs(n: usize) -> Vec<[f64; 3]> {
 }
 
 fn bench(label: &str, setup: &str, file: &str, expr: &str, ds: &[[f64; 3]]) {
-    let lib = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../lib");
+    // FENESTRA_EVAL_LIB: another folder of .cal files (e.g. crates/calc/tests/previous)
+    let lib = std::env::var_os("FENESTRA_EVAL_LIB")
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../lib"));
     let mut p = Program::for_renderer();
     if !setup.is_empty() {
         p.load_str("-e", setup).expect("setup");

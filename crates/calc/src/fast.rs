@@ -363,6 +363,9 @@ struct Fc<'a> {
     nest: u32,
     /// Temporaries written by a sum or a `floor` (never -0).
     no_neg_zero: Vec<bool>,
+    /// While set, emitting an op fails (finding out whether expressions fold to
+    /// constants).
+    probing: bool,
 }
 
 fn is_k(r: u32) -> bool {
@@ -389,6 +392,7 @@ impl<'a> Fc<'a> {
             cse: HashMap::new(),
             nest: 0,
             no_neg_zero: Vec::new(),
+            probing: false,
         }
     }
 
@@ -411,7 +415,7 @@ impl<'a> Fc<'a> {
     }
 
     fn emit(&mut self, op: Op) -> Result<(), GiveUp> {
-        if self.ops.len() >= MAX_OPS {
+        if self.ops.len() >= MAX_OPS || self.probing {
             return Err(GiveUp);
         }
         self.ops.push(op);
@@ -604,10 +608,10 @@ impl<'a> Fc<'a> {
             }
             return self.node(&args[i], fr);
         }
-        if args[1..].iter().all(|a| a.num().is_some()) {
+        // cases that are all constants (literals, or folded after inlining): a table
+        if let Some(vals) = self.constants(&args[1..], fr) {
             let t = self.table.len() as u32;
-            self.table
-                .extend(args[1..].iter().map(|a| a.num().unwrap_or(0.0)));
+            self.table.extend(vals);
             return self.op(|d| Op::SelectK {
                 d,
                 i: ri,
@@ -641,6 +645,35 @@ impl<'a> Fc<'a> {
         }
         self.lists[l as usize + count] = h;
         Ok(d)
+    }
+
+    /// The values of `args` when each folds to a constant without emitting an op;
+    /// otherwise `None`, with everything the attempt compiled forgotten.
+    fn constants(&mut self, args: &'a [Node], fr: usize) -> Option<Vec<f64>> {
+        if let Some(v) = args.iter().map(|a| a.num()).collect::<Option<Vec<f64>>>() {
+            return Some(v);
+        }
+        let (undo, ntemp) = (self.undo.len(), self.ntemp);
+        let (lists, table) = (self.lists.len(), self.table.len());
+        let was = std::mem::replace(&mut self.probing, true);
+        let mut vals = Vec::with_capacity(args.len());
+        for a in args {
+            match self.node(a, fr).ok().and_then(|r| self.kval(r)) {
+                Some(v) => vals.push(v),
+                None => break,
+            }
+        }
+        self.probing = was;
+        if vals.len() == args.len() {
+            return Some(vals);
+        }
+        // no op was emitted; forget the temporaries, cached values and lists
+        self.rollback(undo);
+        self.ntemp = ntemp;
+        self.no_neg_zero.truncate(ntemp as usize);
+        self.lists.truncate(lists);
+        self.table.truncate(table);
+        None
     }
 
     fn builtin(&mut self, b: Builtin, args: &'a [Node], fr: usize) -> Result<u32, GiveUp> {
@@ -1704,6 +1737,28 @@ mod tests {
         }
         assert_eq!(seen, [true; 12]);
         assert!(hits > (special.len() * special.len() * 7) as u64);
+    }
+
+    /// A `select` whose cases fold to constants after inlining is a table lookup (no
+    /// jump table), with the exact evaluator's outcomes (index 0, out of range, NaN).
+    #[test]
+    fn select_of_folded_constants_is_a_table() {
+        let src = "k : 3; f(r) = if(r - 1, 2*r + k, -0);\n\
+                   $1 = select($1, f(0), f(1), f(2), 360/f(3)); $2 = select($2 + 1, f(1), $1, 4);";
+        let special = [f64::NAN, -1.0, 0.0, 0.4, 1.0, 2.0, 3.0, 3.6, 4.0, 5.0, 1e300];
+        let (fast, hits) = agree_on_pairs(src, &special);
+        let ops: Vec<Op> = fast
+            .fast
+            .iter()
+            .filter_map(|f| f.get())
+            .flatten()
+            .flat_map(|f| f.ops.clone())
+            .collect();
+        let tables = ops.iter().filter(|o| matches!(o, Op::SelectK { .. })).count();
+        let jumps = ops.iter().filter(|o| matches!(o, Op::Select { .. })).count();
+        // $1 is a table; $2 has a case that is not a constant (a jump table)
+        assert_eq!((tables, jumps), (1, 1), "{ops:?}");
+        assert!(hits > 0);
     }
 
     #[test]

@@ -41,7 +41,7 @@ pub const KLEMS_NAMES: [&str; 22] = [
     "Nkbins",
 ];
 /// As [`KLEMS_NAMES`] for reinhart.cal.
-pub const REINHART_NAMES: [&str; 14] = [
+pub const REINHART_NAMES: [&str; 16] = [
     "rh_deg",
     "rh_alpha",
     "rh_tnaz",
@@ -53,7 +53,9 @@ pub const REINHART_NAMES: [&str; 14] = [
     "rh_azi",
     "rh_wrapped",
     "rh_col",
-    "rh_bin",
+    "rh_q",
+    "rh_first",
+    "rh_inc",
     "rbin",
     "Nrbins",
 ];
