@@ -25,6 +25,10 @@ fn dirs(n: usize) -> Vec<[f64; 3]> {
 }
 
 fn bench(label: &str, setup: &str, file: &str, expr: &str, ds: &[[f64; 3]]) {
+    // a second argument times only the line of that label (for profiling)
+    if std::env::args().nth(2).is_some_and(|only| only != label) {
+        return;
+    }
     // FENESTRA_EVAL_LIB: another folder of .cal files (e.g. crates/calc/tests/previous)
     let lib = std::env::var_os("FENESTRA_EVAL_LIB")
         .map(std::path::PathBuf::from)
