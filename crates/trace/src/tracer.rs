@@ -1533,13 +1533,11 @@ impl Tracer {
                     } => *rad,
                     _ => f64::INFINITY,
                 };
-                let samples = self.source_samples(sh, p, cx);
-                let count = samples.len();
-                for (q, omega) in samples {
+                let mut emit = |cx: &mut Ctx, q: DVec3, omega: f64, count: usize| {
                     let v = q - p;
                     let dist = v.length();
                     if dist <= 0.0 || dist > maxrad || omega <= 0.0 {
-                        continue;
+                        return;
                     }
                     f(
                         cx,
@@ -1550,6 +1548,18 @@ impl Tracer {
                             count,
                         },
                     );
+                };
+                if let Shape::Sphere { c, r, .. } = &self.accel.shapes[sh] {
+                    // one sample at the centre (as source_samples gives, without a Vec)
+                    if let Some(omega) = Self::sphere_omega(*c, *r, p) {
+                        emit(cx, *c, omega, 1);
+                    }
+                    return;
+                }
+                let samples = self.source_samples(sh, p, cx);
+                let count = samples.len();
+                for (q, omega) in samples {
+                    emit(cx, q, omega, count);
                 }
             }
         }
@@ -1630,6 +1640,15 @@ impl Tracer {
         *val += coef * self.trace(&c, cx);
     }
 
+    /// Solid angle of a sphere (centre `c`, radius `r`) seen from `p` outside it.
+    fn sphere_omega(c: DVec3, r: f64, p: DVec3) -> Option<f64> {
+        let d2 = (c - p).length_squared();
+        if d2 <= r * r {
+            return None;
+        }
+        Some(2.0 * PI * (1.0 - (1.0 - r * r / d2).max(0.0).sqrt()))
+    }
+
     /// Sample points on a local source seen from `p`, with the solid angle each stands for.
     fn source_samples(&self, sh: usize, p: DVec3, cx: &mut Ctx) -> Vec<(DVec3, f64)> {
         let shape = &self.accel.shapes[sh];
@@ -1642,14 +1661,9 @@ impl Tracer {
             }
         };
         match shape {
-            Shape::Sphere { c, r, .. } => {
-                let d2 = (*c - p).length_squared();
-                if d2 <= r * r {
-                    return vec![];
-                }
-                let omega = 2.0 * PI * (1.0 - (1.0 - r * r / d2).max(0.0).sqrt());
-                vec![(*c, omega)]
-            }
+            Shape::Sphere { c, r, .. } => Self::sphere_omega(*c, *r, p)
+                .map(|omega| vec![(*c, omega)])
+                .unwrap_or_default(),
             Shape::Ring { c, n, r0, r1 } => {
                 let size = 2.0 * r1;
                 let k = self.divisions(size, (*c - p).length());

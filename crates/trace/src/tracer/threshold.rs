@@ -19,13 +19,14 @@
 //! any number of threads.
 
 use super::*;
+use std::sync::atomic::{AtomicU32, Ordering};
 
 /// Shadow tests always made before the threshold applies (Radiance's MINSHADCNT).
 pub(super) const MIN_TESTS: usize = 2;
 /// Obstructor cache resolution (cells per side of a cube face; Radiance's SHADCACHE).
 const RES: usize = 20;
-/// Sources after this many get an empty obstructor cache instead of a pre-cast one
-/// (Radiance's MAX2SHADE), bounding the set-up cost.
+/// Sources after this many start with an empty obstructor cache instead of a cast one
+/// (Radiance's MAX2SHADE).
 const MAX_PRECAST: usize = 200;
 
 /// Photopic brightness of an RGB colour (Radiance's default primaries).
@@ -101,12 +102,18 @@ pub(super) enum CacheGeom {
     },
 }
 
-/// A source's obstructor cache as the scene alone gives it (before any ray).
-#[derive(Debug, Clone)]
+/// A source's obstructor cache as the scene alone gives it (before any ray). Radiance
+/// casts every cell when the source is first looked up; fenestra casts a cell when it is
+/// first looked up, by whichever thread needs it — its content depends on the scene only.
+#[derive(Debug)]
 pub(super) struct ObsCache {
     geom: CacheGeom,
-    cells: Vec<u32>,
+    /// Per cell: [`UNCAST`], or 0 (no blocker) or blocker index + 1.
+    cells: Vec<AtomicU32>,
 }
+
+/// A cell not cast yet.
+const UNCAST: u32 = u32::MAX;
 
 /// Cell of a coordinate in [-1, 1] at `n` cells. The scale is a hair under n/2 so that
 /// a coordinate on a cell boundary (as 0.5 is) goes to the lower cell, as in Radiance:
@@ -136,19 +143,20 @@ impl CacheGeom {
         match self {
             CacheGeom::Round { .. } => {
                 let m = l.abs();
-                let mut ax = 2;
-                for k in [1, 0] {
-                    if m[k] > m[ax] {
-                        ax = k;
-                    }
-                }
-                if m[ax] <= 0.0 {
+                // the largest component, ties to the last axis; the other two in turn
+                let (ax, big, x, y) = if m.x > m.y.max(m.z) {
+                    (0, l.x, l.y, l.z)
+                } else if m.y > m.z {
+                    (1, l.y, l.z, l.x)
+                } else {
+                    (2, l.z, l.x, l.y)
+                };
+                if big == 0.0 {
                     return None;
                 }
-                let face = 2 * ax + usize::from(l[ax] < 0.0);
-                let x = l[(ax + 1) % 3] / m[ax];
-                let y = l[(ax + 2) % 3] / m[ax];
-                Some(face * RES * RES + bin(x, RES) * RES + bin(y, RES))
+                let inv = 1.0 / big.abs();
+                let face = 2 * ax + usize::from(big < 0.0);
+                Some(face * RES * RES + bin(x * inv, RES) * RES + bin(y * inv, RES))
             }
             CacheGeom::Flat { a, b, n, .. } => {
                 let u = -l;
@@ -183,57 +191,47 @@ impl CacheGeom {
         }
     }
 
-    /// Rays cast from the source outward, one through the middle of every cell.
-    fn casts(&self) -> Vec<(DVec3, DVec3)> {
-        let mut out = Vec::with_capacity(self.len());
+    /// The ray cast from the source outward through the middle of cell `k` (origin,
+    /// unit direction): its first reliable blocker is the cell's initial content.
+    fn cast(&self, k: usize) -> (DVec3, DVec3) {
+        let nn = RES * RES;
         match self {
             CacheGeom::Round { c, r } => {
-                for ax in 0..3 {
-                    for sign in [1.0, -1.0] {
-                        for i in 0..RES {
-                            for j in 0..RES {
-                                let mut u = DVec3::ZERO;
-                                u[ax] = sign;
-                                u[(ax + 1) % 3] = centre(i, RES);
-                                u[(ax + 2) % 3] = centre(j, RES);
-                                let u = u.normalize();
-                                out.push((*c + u * (1.05 * r), u));
-                            }
-                        }
-                    }
-                }
+                let (face, i, j) = (k / nn, (k / RES) % RES, k % RES);
+                let ax = face / 2;
+                // cells are indexed by the direction toward the source: cast the other way
+                let mut l = DVec3::ZERO;
+                l[ax] = if face % 2 == 1 { -1.0 } else { 1.0 };
+                l[(ax + 1) % 3] = centre(i, RES);
+                l[(ax + 2) % 3] = centre(j, RES);
+                let u = -l.normalize();
+                (*c + u * (1.05 * r), u)
             }
             CacheGeom::Flat { c, a, b, n, reach } => {
                 let o = *c + *n * (0.01 * reach);
-                for i in 0..RES {
-                    for j in 0..RES {
-                        let u = *a * centre(i, RES) + *b * centre(j, RES) + *n;
-                        out.push((o, u.normalize()));
-                    }
+                if k < nn {
+                    let u = *a * centre(k / RES, RES) + *b * centre(k % RES, RES) + *n;
+                    return (o, u.normalize());
                 }
                 let half = RES / 2;
-                for (main, other) in [(*a, *b), (-*a, *b), (*b, *a), (-*b, *a)] {
-                    for k in 0..half {
-                        for j in 0..RES {
-                            let z = (k as f64 + 0.5) / half as f64;
-                            let u = main + other * centre(j, RES) + *n * z;
-                            out.push((o, u.normalize()));
-                        }
-                    }
-                }
+                let k = k - nn;
+                let (side, row, j) = (k / (half * RES), (k / RES) % half, k % RES);
+                let (main, other) = match side {
+                    0 => (*a, *b),
+                    1 => (-*a, *b),
+                    2 => (*b, *a),
+                    _ => (-*b, *a),
+                };
+                let u = main + other * centre(j, RES) - *n * centre(row, RES);
+                (o, u.normalize())
             }
             CacheGeom::Distant { s, a, b, c, r } => {
                 let m = 2 * RES;
-                for i in 0..m {
-                    for j in 0..m {
-                        let o =
-                            *c + *a * (centre(i, m) * r) + *b * (centre(j, m) * r) + *s * (2.0 * r);
-                        out.push((o, -*s));
-                    }
-                }
+                let o =
+                    *c + *a * (centre(k / m, m) * r) + *b * (centre(k % m, m) * r) + *s * (2.0 * r);
+                (o, -*s)
             }
         }
-        out
     }
 }
 
@@ -342,17 +340,25 @@ impl Tracer {
                         Shape::Cone { .. } => return None,
                     },
                 };
-                let mut cells = vec![0u32; geom.len()];
-                if si < MAX_PRECAST {
-                    for (o, u) in geom.casts() {
-                        if let (Some(b), Some(k)) = (self.first_blocker(o, u), geom.cell(o, -u)) {
-                            cells[k] = b as u32 + 1;
-                        }
-                    }
-                }
+                let first = if si < MAX_PRECAST { UNCAST } else { 0 };
+                let cells = (0..geom.len()).map(|_| AtomicU32::new(first)).collect();
                 Some(ObsCache { geom, cells })
             })
             .collect()
+    }
+
+    /// Cell `k` of a source's initial cache: the first reliable blocker met by the cell's
+    /// cast (0: none, else index + 1).
+    fn initial_cell(&self, oc: &ObsCache, k: usize) -> u32 {
+        let v = oc.cells[k].load(Ordering::Relaxed);
+        if v != UNCAST {
+            return v;
+        }
+        let (o, u) = oc.geom.cast(k);
+        let v = self.first_blocker(o, u).map_or(0, |b| b as u32 + 1);
+        // threads racing here store the same value
+        oc.cells[k].store(v, Ordering::Relaxed);
+        v
     }
 
     /// The first surface along a ray that is a reliable blocker (skipping others).
@@ -369,14 +375,14 @@ impl Tracer {
     }
 
     /// Whether the cached obstructor of source `si` blocks the shadow ray from `p` along
-    /// `l` before it reaches the source (at `tsrc`).
+    /// `l` (length `tmax`) before it reaches the source.
     fn cache_blocks(
         &self,
         st: &DirectState,
         si: usize,
         p: DVec3,
         l: DVec3,
-        tsrc: f64,
+        tmax: f64,
         skip: Option<usize>,
     ) -> bool {
         let Some(Some(oc)) = self.obs.as_ref().map(|o| &o[si]) else {
@@ -385,14 +391,24 @@ impl Tracer {
         let Some(k) = oc.geom.cell(p, l) else {
             return false;
         };
-        let cells = st.cache[si].as_deref().unwrap_or(&oc.cells);
-        let b = cells[k];
+        let b = match st.cache[si].as_deref().map(|c| c[k]) {
+            Some(v) if v != UNCAST => v,
+            _ => self.initial_cell(oc, k),
+        };
         if b == 0 || Some(b as usize - 1) == skip || self.own_emitter(si, b as usize - 1) {
             return false;
         }
-        self.accel.shapes[b as usize - 1]
-            .intersect(p, l, Self::tmin(p), tsrc)
-            .is_some()
+        let tmin = Self::tmin(p);
+        let Some(tb) = self.accel.shapes[b as usize - 1].intersect(p, l, tmin, tmax) else {
+            return false;
+        };
+        // blocked unless the source itself is met first
+        match self.sources[si].geom {
+            SourceGeom::Local(sh) => self.accel.shapes[sh]
+                .intersect(p, l, tmin, f64::INFINITY)
+                .is_none_or(|ts| tb < ts),
+            _ => true,
+        }
     }
 
     /// Whether shape `b` emits with source `si`'s material (not a blocker of that source).
@@ -420,41 +436,57 @@ impl Tracer {
             return;
         };
         if self.blocker[h.shape] && !self.own_emitter(si, h.shape) {
-            st.cache[si].get_or_insert_with(|| oc.cells.clone())[k] = h.shape as u32 + 1;
+            st.cache[si].get_or_insert_with(|| {
+                oc.cells.iter().map(|c| c.load(Ordering::Relaxed)).collect()
+            })[k] = h.shape as u32 + 1;
         }
     }
 
     /// Radiance a shadow ray `c` (aimed at source `si`) would bring if nothing were in
-    /// the way, and where it meets the source (`tsrc`, for the cache test).
-    fn potential(&self, c: &Ray, si: usize, cx: &mut Ctx) -> (DVec3, f64) {
+    /// the way.
+    fn potential(&self, c: &Ray, si: usize, cx: &mut Ctx) -> DVec3 {
         let s = &self.sources[si];
         let tmin = Self::tmin(c.org);
         match s.geom {
             SourceGeom::Distant(k) => {
                 let d = &self.distant[k];
-                let v = self.shade_light(c, d.mat, 1.0, f64::INFINITY, DVec3::ZERO, None, cx);
-                (v.0, f64::INFINITY)
+                self.shade_light(c, d.mat, 1.0, f64::INFINITY, DVec3::ZERO, None, cx)
+                    .0
             }
             SourceGeom::Local(sh) => {
                 let shp = &self.accel.shapes[sh];
+                if let (
+                    Shape::Sphere { inward: false, .. },
+                    Material::Light {
+                        color,
+                        kind: LightKind::Light,
+                    },
+                ) = (shp, &self.mats[&s.mat])
+                {
+                    // a plain light sphere seen from outside (the sample is its centre):
+                    // its colour, unless a pattern modifies it
+                    if self.patterns.get(&s.mat).is_none() {
+                        return *color;
+                    }
+                }
                 match shp.intersect(c.org, c.dir, tmin, f64::INFINITY) {
                     Some(t) => {
                         let q = c.org + c.dir * t;
                         let rod = -c.dir.dot(shp.normal(q));
-                        (self.shade_light(c, s.mat, rod, t, q, Some(sh), cx).0, t)
+                        self.shade_light(c, s.mat, rod, t, q, Some(sh), cx).0
                     }
-                    None => (DVec3::ZERO, c.tmax),
+                    None => DVec3::ZERO,
                 }
             }
             SourceGeom::Virtual { base, mirror, .. } => {
                 let shp = &self.accel.shapes[mirror];
                 let Some(t) = shp.intersect(c.org, c.dir, tmin, f64::INFINITY) else {
-                    return (DVec3::ZERO, f64::INFINITY);
+                    return DVec3::ZERO;
                 };
                 let (Material::Mirror { color }, SourceGeom::Distant(k)) =
                     (&self.mats[&self.surf_mat[mirror]], self.sources[base].geom)
                 else {
-                    return (DVec3::ZERO, f64::INFINITY);
+                    return DVec3::ZERO;
                 };
                 let q = c.org + c.dir * t;
                 let n = shp.normal(q);
@@ -462,14 +494,14 @@ impl Tracer {
                 let nrm = if rod < 0.0 { -n } else { n };
                 let d = &self.distant[k];
                 if d.dir.dot(nrm) <= 0.0 {
-                    return (DVec3::ZERO, f64::INFINITY);
+                    return DVec3::ZERO;
                 }
                 let mut rc = c.clone();
                 rc.org = q;
                 rc.dir = (c.dir + nrm * (2.0 * rod.abs())).normalize();
                 rc.src = Some(base);
                 let v = self.shade_light(&rc, d.mat, 1.0, f64::INFINITY, DVec3::ZERO, None, cx);
-                (*color * v.0, f64::INFINITY)
+                *color * v.0
             }
         }
     }
@@ -495,16 +527,12 @@ impl Tracer {
         cands.clear();
         for si in 0..self.sources.len() {
             self.each_sample(si, p, shape, cx, |cx, s| {
-                let mut c = self.child(r, p, s.l, SHADOW, DVec3::ONE, skip, 0.0);
-                c.weight = r.weight;
-                c.src = Some(si);
-                c.tmax = s.tmax;
-                let (pot, tsrc) = self.potential(&c, si, cx);
                 let single = s.count == 1;
                 let Some(st) = cx.ds.as_deref_mut() else {
                     return;
                 };
-                if single && self.cache_blocks(st, si, p, s.l, tsrc.min(s.tmax), skip) {
+                // a sample its cached obstructor blocks counts as a failed test
+                if single && self.cache_blocks(st, si, p, s.l, s.tmax, skip) {
                     st.ntests[si] += 1;
                     return;
                 }
@@ -512,7 +540,11 @@ impl Tracer {
                 if maxc(coef) <= 0.0 {
                     return;
                 }
-                let val = coef * pot;
+                let mut c = self.child(r, p, s.l, SHADOW, DVec3::ONE, skip, 0.0);
+                c.weight = r.weight;
+                c.src = Some(si);
+                c.tmax = s.tmax;
+                let val = coef * self.potential(&c, si, cx);
                 let brt = bright(val) as f32;
                 if brt > 0.0 {
                     cands.push(Candidate {
@@ -593,5 +625,56 @@ impl Tracer {
             st.tail = tail;
         }
         total
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every cell's cast, looked up as a shadow ray coming back along it, lands in that
+    /// cell (the cast fills the cell lookups read).
+    #[test]
+    fn every_cell_cast_comes_back_to_its_cell() {
+        let (a, b) = frame(DVec3::new(0.3, -0.2, 0.9).normalize());
+        let n = a.cross(b);
+        let geoms = [
+            CacheGeom::Round {
+                c: DVec3::new(1.0, 2.0, 3.0),
+                r: 0.1,
+            },
+            CacheGeom::Flat {
+                c: DVec3::new(-1.0, 0.5, 2.0),
+                a,
+                b,
+                n,
+                reach: 0.3,
+            },
+            CacheGeom::Distant {
+                s: n,
+                a,
+                b,
+                c: DVec3::new(5.0, 5.0, 1.0),
+                r: 8.0,
+            },
+        ];
+        for g in &geoms {
+            for k in 0..g.len() {
+                let (o, u) = g.cast(k);
+                // a point further along the cast, looking back at the source
+                let p = o + u * 2.5;
+                assert_eq!(g.cell(p, -u), Some(k), "{g:?} cell {k}");
+            }
+        }
+    }
+
+    #[test]
+    fn boundary_coordinates_go_to_the_lower_cell() {
+        // 0.5 is the boundary of cells 14 and 15 of 20 over [-1, 1]
+        assert_eq!(bin(0.5, RES), 14);
+        assert_eq!(bin(0.5 + 1e-9, RES), 14);
+        assert_eq!(bin(0.55, RES), 15);
+        assert_eq!(bin(-1.0, RES), 0);
+        assert_eq!(bin(1.0, RES), RES - 1);
     }
 }

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# rtrace source thresholding (-dt/-dc) against the oracle, same run, same machine: the 60-lamp,
+# 20-partition scene of tests/fixtures/direct_threshold, each tool with -dt .03 (its default) and -dt 0,
+# single process/thread (-n 1), hyperfine.
+#   A: -I+ -ab 0 over 3000 points (the fixture's 30 points shifted 100 times by 1.3 cm)
+#   B: -I+ -ab 1 -ad 256 over the fixture's 30 points
+# Usage: benches/rtrace_dt.sh [runs]   (needs .oracle/env and a testopt build of rtrace)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+runs=${1:-3}
+set -a; . .oracle/env 2>/dev/null || . /work/main/.oracle/env; set +a
+export FENESTRA_NO_PROGRESS=1
+ours=$(realpath "${CARGO_TARGET_DIR:-target}/testopt/rtrace")
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+cp tests/fixtures/direct_threshold/{scene.rad,points.txt} "$tmp/"
+cd "$tmp"
+awk '{for (k = 0; k < 100; k++) print $1 + 0.013 * k, $2, $3, $4, $5, $6}' points.txt > many.txt
+RAYPATH=.:$FENESTRA_ORACLE_LIB "$FENESTRA_ORACLE_BIN/oconv" scene.rad > s.oct
+ref="RAYPATH=.:$FENESTRA_ORACLE_LIB $FENESTRA_ORACLE_BIN/rtrace"
+for case in "A|-h -I+ -ab 0 -n 1|many.txt" "B|-h -I+ -ab 1 -ad 256 -n 1|points.txt"; do
+  IFS='|' read -r name opts input <<< "$case"
+  echo "== $name: $opts < $input ($(wc -l < "$input") records); load: $(uptime | sed 's/.*load/load/')"
+  hyperfine -w 1 -r "$runs" --export-markdown "times_$name.md" \
+    -n "oracle -dt 0" "$ref $opts -dt 0 s.oct < $input" \
+    -n "oracle -dt .03" "$ref $opts -dt .03 s.oct < $input" \
+    -n "fenestra -dt 0" "$ours $opts -dt 0 scene.rad < $input" \
+    -n "fenestra -dt .03" "$ours $opts -dt .03 scene.rad < $input" > /dev/null
+  cat "times_$name.md"
+  for dt in 0 .03; do
+    echo "fenestra -dt $dt: $("$ours" -v $opts -dt $dt scene.rad < "$input" 2>&1 >/dev/null | tail -1)"
+  done
+done
