@@ -63,6 +63,9 @@ fn bench(label: &str, setup: &str, file: &str, expr: &str, ds: &[[f64; 3]]) {
 /// For scale: `rbin` of reinhart.cal with MF 1 written directly in Rust (the same
 /// operations: asin, atan2, floors, divisions), timed like the evaluator.
 fn native_rbin(ds: &[[f64; 3]]) {
+    if std::env::args().nth(2).is_some_and(|only| only != "rbin*") {
+        return;
+    }
     const TNAZ: [f64; 8] = [30.0, 30.0, 24.0, 24.0, 18.0, 12.0, 6.0, 1.0];
     const TSUM: [f64; 8] = [0.0, 30.0, 60.0, 84.0, 108.0, 126.0, 138.0, 144.0];
     let deg = 180.0 / std::f64::consts::PI;
