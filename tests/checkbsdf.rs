@@ -376,9 +376,21 @@ fn random_tree(
     format!("{{ {} }}", vals.join(" "))
 }
 
+/// The tree text with every number passed through `f`.
+fn rescale_tree(tree: &str, f: impl Fn(f64) -> f64) -> String {
+    tree.split(' ')
+        .map(|w| match w.parse::<f64>() {
+            Ok(v) => format!("{:.5}", f(v)),
+            Err(_) => w.to_string(),
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
 /// Random rank-3 and rank-4 trees (refined to different depths, zeros, Lambertian floors; one
-/// to four components) checked in one run: every line of Radiance's sections equal to the
-/// oracle's, reciprocity rows included, while the generator runs on across 30 files.
+/// to four components; ten files coloured with CIE-u/v trees) checked in one run: every line of
+/// Radiance's sections equal to the oracle's (Lambertian colours, `Color:` flag, reciprocity rows)
+/// while the generator runs on across 40 files.
 #[test]
 fn oracle_random_tree_reciprocity() {
     let Some(o) = common::oracle() else { return };
@@ -398,23 +410,27 @@ fn oracle_random_tree_reciprocity() {
     );
     let sets: [&[&str]; 5] = [&[rb], &[tf, tb], &[rb, rf, tf, tb], &[tb], &[rf, tf]];
     let mut files = Vec::new();
-    for k in 0..30 {
+    for k in 0..40 {
         let rank = if k % 3 == 2 { 4 } else { 3 };
         let depth = if rank == 3 { 1 + k % 3 } else { 1 + k % 2 } as u32;
         let (zeros, floor) = (k % 4 == 1, k % 4 == 3);
+        // Files 30..39 are coloured: CIE-u and CIE-v trees (u′ 0.18–0.24, v′ 0.44–0.50).
+        let coloured = k >= 30;
         let set = sets[(next() * sets.len() as f64) as usize];
-        let blocks: Vec<(&str, &str, String)> = set
-            .iter()
-            .map(|d| {
-                (
-                    *d,
-                    "BTDF",
-                    random_tree(&mut next, rank, depth, zeros, floor),
-                )
-            })
-            .collect();
+        let mut blocks: Vec<(&str, &str, &str, String)> = Vec::new();
+        for d in set {
+            let y = random_tree(&mut next, rank, depth, zeros, floor);
+            blocks.push(("Visible", d, "BTDF", y));
+            if coloured {
+                for (wl, lo) in [("CIE-u", 0.18), ("CIE-v", 0.44)] {
+                    let t = random_tree(&mut next, rank, 1, false, false);
+                    let t = rescale_tree(&t, |v| lo + 0.02 * v);
+                    blocks.push((wl, d, "BTDF", t));
+                }
+            }
+        }
         let name = format!("r{rank}_{k:02}.xml");
-        let p = tree_file(&dir, &name, &blocks);
+        let p = tree_file_wl(&dir, &name, &blocks);
         if rank == 3 {
             let t = std::fs::read_to_string(&p).unwrap();
             std::fs::write(&p, t.replace("TensorTree4", "TensorTree3")).unwrap();
@@ -445,14 +461,24 @@ fn grid_tree(g: u32, v: impl Fn(usize, usize, usize, usize) -> f64) -> String {
 /// blinds_t4.xml with its `<WavelengthData>` elements replaced by Visible tree blocks
 /// `(direction, data type, tree text)`.
 fn tree_file(dir: &Path, name: &str, blocks: &[(&str, &str, String)]) -> PathBuf {
+    let blocks: Vec<(&str, &str, &str, String)> = blocks
+        .iter()
+        .map(|(d, ty, t)| ("Visible", *d, *ty, t.clone()))
+        .collect();
+    tree_file_wl(dir, name, &blocks)
+}
+
+/// [`tree_file`] with each block's `Wavelength` given: `(wavelength, direction, data type,
+/// tree text)`.
+fn tree_file_wl(dir: &Path, name: &str, blocks: &[(&str, &str, &str, String)]) -> PathBuf {
     let text = std::fs::read_to_string(common::fixture("dctimestep/blinds_t4.xml")).unwrap();
     let a = text.find("<WavelengthData>").unwrap();
     let b = text.rfind("</WavelengthData>").unwrap() + "</WavelengthData>".len();
     let mut out = text[..a].to_string();
-    for (d, ty, tree) in blocks {
+    for (wl, d, ty, tree) in blocks {
         out.push_str(&format!(
             "<WavelengthData>\n<LayerNumber>System</LayerNumber>\n\
-             <Wavelength unit=\"Integral\">Visible</Wavelength>\n<WavelengthDataBlock>\n\
+             <Wavelength unit=\"Integral\">{wl}</Wavelength>\n<WavelengthDataBlock>\n\
              <WavelengthDataDirection>{d}</WavelengthDataDirection>\n\
              <AngleBasis>LBNL/Shirley-Chiu</AngleBasis>\n\
              <ScatteringDataType>{ty}</ScatteringDataType>\n\

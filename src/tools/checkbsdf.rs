@@ -9,8 +9,9 @@ use std::path::Path;
 use std::process::ExitCode;
 
 use anyhow::{anyhow, bail, Result};
-use fenestra_bsdf::check::sampled::SampledRow;
+use fenestra_bsdf::check::sampled::{SampledRow, TreeFile};
 use fenestra_bsdf::check::{self, ComponentCheck, Reciprocity};
+use fenestra_bsdf::radiance::Drand48;
 use fenestra_bsdf::{BlockData, Bsdf, Direction, Wavelength};
 use fenestra_cli::opts::{Item, Spec};
 use fenestra_formats::matrix::format_c_g;
@@ -26,10 +27,6 @@ fn spec() -> Spec {
 /// Light gained beyond this fraction (T + R > 1 + this) is reported as not conserved:
 /// Monte Carlo BSDFs (genBSDF) carry noise of this order.
 const ENERGY_NOISE: f64 = 0.01;
-
-/// Coloured tree reciprocity rows: largest spread of pair errors (a fraction) for which the grid is
-/// finished; beyond it min and max cannot print the same.
-const SPREAD: f64 = 0.001;
 
 /// Runs checkBSDF.
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
@@ -53,11 +50,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         let b = fenestra_bsdf::read_file(&path).map_err(|e| anyhow!("{e}"))?;
         let colour = fenestra_bsdf::radiance::colour_lambertians(&b, &mut rng);
         let xml = std::fs::read_to_string(&path).map_err(|e| anyhow!("{}: {e}", path.display()))?;
-        let sampled = |totals| {
-            check::sampled::tree_rows(&xml, totals, &mut rng)
-                .map_err(|e| anyhow!("{}: {e}", path.display()))
-        };
-        let text = report(f, &b, &colour, sampled)?;
+        let trees = TreeFile::load(&xml).map_err(|e| anyhow!("{}: {e}", path.display()))?;
+        let text = report(f, &b, &colour, trees, &mut rng)?;
         out.write_all(text.as_bytes())?;
         out.flush()?;
     }
@@ -103,13 +97,14 @@ fn angle(a: f64) -> String {
 }
 
 /// The report for one file (`colour`: the coloured Lambertian parts split off on loading;
-/// `sampled`: the reciprocity rows of a grey tensor-tree file, from `check::sampled`, given the
-/// components' largest directional totals).
+/// `trees`: a tensor-tree file as Radiance loads it, for its Lambertian parts and reciprocity
+/// rows; `rng`: the process's generator).
 fn report(
     name: &str,
     b: &Bsdf,
     colour: &[(Direction, [f64; 3])],
-    sampled: impl FnOnce([Option<f64>; 4]) -> Result<Option<[SampledRow; 3]>>,
+    trees: Option<TreeFile>,
+    rng: &mut Drand48,
 ) -> Result<String> {
     let mut s = String::new();
     let tree = b
@@ -123,14 +118,28 @@ fn report(
             check::component_with(b, d, colour)
         }
     };
-    let (rf, rb) = (
+    let (mut rf, mut rb) = (
         comp(Direction::ReflectionBack),
         comp(Direction::ReflectionFront),
     );
-    let (tf, tb) = (
+    let (mut tf, mut tb) = (
         comp(Direction::TransmissionBack),
         comp(Direction::TransmissionFront),
     );
+    // Tensor trees: the Lambertian parts as Radiance splits them on loading (grey: π × the
+    // reachable minimum; coloured: per-channel Sharp RGB minima).
+    if let Some(t) = &trees {
+        for (c, l) in [&mut rf, &mut rb, &mut tf, &mut tb]
+            .into_iter()
+            .zip(t.lambertians())
+        {
+            if let Some(c) = c {
+                c.lambertian_xyz = l.xyz;
+                c.lambertian_y = l.y / std::f64::consts::PI;
+            }
+        }
+    }
+    let totals = [&rf, &rb, &tf, &tb].map(|c| c.as_ref().map(|c| c.max_total));
     // Radiance drops a component whose largest directional total, its Lambertian part removed,
     // is at most 0.001; the split-off part still prints (as a missing transmission's).
     let dropped = |c: &ComponentCheck| c.max_total - c.lambertian_xyz[1] <= 0.001;
@@ -156,7 +165,10 @@ fn report(
         data_type(b)
     };
     writeln!(s, "Type: {kind}")?;
-    writeln!(s, "Color: {}", u8::from(b.has_colour()))?;
+    let colour_flag = trees
+        .as_ref()
+        .map_or(b.has_colour(), |t| t.colour_flag(totals));
+    writeln!(s, "Color: {}", u8::from(colour_flag))?;
     let geom = b
         .geometry
         .as_ref()
@@ -220,17 +232,11 @@ fn report(
             None => writeln!(s, "{label}\t  0\t  0\t  0"),
         };
     };
-    let sampled = if tree {
-        let total = |c: &Option<ComponentCheck>| c.as_ref().map(|c| c.max_total);
-        sampled([total(&rf), total(&rb), total(&tf), total(&tb)])?
-    } else {
-        None
-    };
-    if let Some(rows) = sampled {
-        // Grey tensor trees: Radiance's sampled rows, reproduced (check::sampled).
+    if let Some(t) = trees {
+        // Tensor trees: Radiance's sampled rows, reproduced (check::sampled).
         for (label, r) in ["Interior Refl", "Exterior Refl", "Transmission"]
             .into_iter()
-            .zip(rows)
+            .zip(t.rows(totals, rng))
         {
             match r {
                 SampledRow::Values(r) => rec(&mut s, label, Some(r)),
@@ -238,37 +244,6 @@ fn report(
                 SampledRow::Dropped => {}
             }
         }
-    } else if tree {
-        // Coloured tensor trees (CIE-u/v blocks): Radiance's sampling is not reproduced for
-        // them; a row is printed only where no sampling can change it (every pair's error the
-        // same to the printed precision on the finest grid, abandoned once two errors differ
-        // by more than 0.1%).
-        let trec = |s: &mut String, label: &str, r: Option<Option<Reciprocity>>| match r {
-            Some(Some(r))
-                if format!("{:5.1}", 100.0 * r.min) == format!("{:5.1}", 100.0 * r.max) =>
-            {
-                rec(s, label, Some(r))
-            }
-            Some(_) => {
-                let _ = writeln!(s, "{label}\t(not computed by fenestra for tensor trees)");
-            }
-            None => rec(s, label, None),
-        };
-        trec(
-            &mut s,
-            "Interior Refl",
-            check::tree::tree_reflection_reciprocity(b, Direction::ReflectionBack, SPREAD),
-        );
-        trec(
-            &mut s,
-            "Exterior Refl",
-            check::tree::tree_reflection_reciprocity(b, Direction::ReflectionFront, SPREAD),
-        );
-        trec(
-            &mut s,
-            "Transmission",
-            check::tree::tree_transmission_reciprocity(b, SPREAD),
-        );
     } else {
         rec(
             &mut s,

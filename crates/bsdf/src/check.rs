@@ -11,7 +11,6 @@
 //! all element pairs whose elements both exceed 1e-4.
 
 pub mod sampled;
-pub mod tree;
 
 use crate::klems::KlemsBasis;
 use crate::model::{Bsdf, Direction, KlemsMatrix, Wavelength};

@@ -192,7 +192,7 @@ const XYZ_TO_SHARP_F: [[f32; 3]; 3] = [
 
 /// Radiance's Sharp RGB → XYZ matrix: its own four-decimal table (single precision), not the
 /// exact inverse of [`XYZ_TO_SHARP_F`].
-const XYZ_FROM_SHARP_F: [[f32; 3]; 3] = [
+pub(crate) const XYZ_FROM_SHARP_F: [[f32; 3]; 3] = [
     [0.8156, 0.0472, 0.1372],
     [0.3791, 0.5769, 0.0440],
     [-0.0123, 0.0167, 0.9955],
@@ -216,7 +216,7 @@ fn decode_xy((ub, vb): (f64, f64)) -> (f32, f32) {
 }
 
 /// Sharp RGB (single precision) of chromaticity (x, y) at luminance `y`.
-fn to_sharp((cx, cy): (f32, f32), y: f64) -> [f32; 3] {
+pub(crate) fn to_sharp((cx, cy): (f32, f32), y: f64) -> [f32; 3] {
     let xyz = [
         f64::from(cx / cy) * y,
         y,
@@ -229,7 +229,7 @@ fn to_sharp((cx, cy): (f32, f32), y: f64) -> [f32; 3] {
 
 /// Luminance and chromaticity of a Sharp RGB colour (Radiance's table); the chromaticity is
 /// `None` (Radiance's default white) when the luminance is at most 1e-6.
-fn from_sharp(c: [f32; 3]) -> (f64, Option<(f32, f32)>) {
+pub(crate) fn from_sharp(c: [f32; 3]) -> (f64, Option<(f32, f32)>) {
     let row = |r: [f32; 3]| {
         f64::from(r[0]) * f64::from(c[0])
             + f64::from(r[1]) * f64::from(c[1])

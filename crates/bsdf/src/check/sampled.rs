@@ -21,14 +21,16 @@
 //!
 //! Tree values are looked up as Radiance does: nearest leaf, after the Lambertian minimum is
 //! subtracted (float arithmetic), times Radiance's position-dependent factor `1 + 1e-4·d` that
-//! keeps equal leaves apart. The generator is the process's one (the colour dither's): state
-//! runs on from file to file.
+//! keeps equal leaves apart; a coloured component's value is the sum of its luminance-weighted
+//! Sharp RGB channels from the u′, v′ trees. The Lambertian parts are split off as Radiance's
+//! loader does (grey: the reachable minimum; coloured: [`Tree::split_colour`]). The generator is
+//! the process's one (the colour dither's): state runs on from file to file.
 
 use std::f64::consts::{FRAC_PI_4, PI};
 
 use crate::check::Reciprocity;
 use crate::model::Direction;
-use crate::radiance::Drand48;
+use crate::radiance::{from_sharp, to_sharp, Drand48, XYZ_FROM_SHARP_F};
 
 /// Radiance's `FTINY`.
 const FTINY: f64 = 1e-6;
@@ -58,6 +60,10 @@ struct Tree {
     rank: usize,
     side: Side,
     root: Node,
+    /// CIE u′ and v′ trees of a coloured component (Radiance loses them when a rank-3 coloured
+    /// component has a Lambertian part split off, see [`Tree::split_colour`]).
+    u: Option<Node>,
+    v: Option<Node>,
 }
 
 /// A leaf found by a lookup: its value and its hypercube (lower corner, edge).
@@ -69,51 +75,7 @@ struct Leaf {
 
 impl Tree {
     fn lookup(&self, pos: &[f64; 4]) -> Leaf {
-        let r = self.rank;
-        let mut p = *pos;
-        let mut corner = [0.0; 4];
-        let mut edge = 1.0;
-        let mut node = &self.root;
-        loop {
-            match node {
-                Node::Branch(ch) => {
-                    edge *= 0.5;
-                    let mut n = 0;
-                    for i in (0..r).rev() {
-                        let s = 2.0 * p[i];
-                        let t = usize::from(s >= 1.0);
-                        n |= t << i;
-                        p[i] = s - t as f64;
-                        corner[i] += t as f64 * edge;
-                    }
-                    node = &ch[n];
-                }
-                Node::Grid { log2, values } => {
-                    if *log2 == 0 {
-                        return Leaf {
-                            value: values[0],
-                            corner,
-                            edge,
-                        };
-                    }
-                    let cells = (1u64 << log2) as f64;
-                    let top = (1usize << log2) - 1;
-                    let mut n = 0usize;
-                    for v in &p[..r] {
-                        n = (n << log2) + ((cells * v) as usize).min(top);
-                    }
-                    edge /= cells;
-                    for i in (0..r).rev() {
-                        corner[i] += (cells * p[i]).floor().min(top as f64) * edge;
-                    }
-                    return Leaf {
-                        value: values[n],
-                        corner,
-                        edge,
-                    };
-                }
-            }
-        }
+        lookup_node(&self.root, self.rank, pos)
     }
 
     /// Edge of the smallest leaf.
@@ -228,6 +190,11 @@ impl Tree {
 
     /// The leaf for the pair `(a, b)` in Radiance's tree-query order.
     fn query(&self, a: [f64; 3], b: [f64; 3]) -> Option<Leaf> {
+        Some(self.lookup(&self.position(a, b)?))
+    }
+
+    /// Tree coordinates of the pair `(a, b)` in Radiance's tree-query order.
+    fn position(&self, a: [f64; 3], b: [f64; 3]) -> Option<[f64; 4]> {
         let (i, o) = self.orient(a, b)?;
         let mut pos = [0.0; 4];
         if self.rank == 3 {
@@ -242,19 +209,122 @@ impl Tree {
             let (s, t) = disk_to_square(o[0], o[1]);
             pos = [u, v, s, t];
         }
-        Some(self.lookup(&pos))
+        Some(pos)
     }
 
     /// The tree's BSDF value for the pair as Radiance returns it (float, with its
     /// position-dependent factor).
-    fn value(&self, a: [f64; 3], b: [f64; 3]) -> Option<f32> {
-        let leaf = self.query(a, b)?;
+    /// The tree's BSDF coefficients for the pair as Radiance returns them: one (grey) or three
+    /// (Sharp RGB weighted by the primaries' luminances, from the value and the u′, v′ trees).
+    fn coefs(&self, a: [f64; 3], b: [f64; 3]) -> Option<([f32; 3], usize)> {
+        let pos = self.position(a, b)?;
+        let leaf = self.lookup(&pos);
         let mut d = 0.0;
         for i in (0..self.rank).rev() {
             let x = f64::from(2u32 << i) / (leaf.corner[i] + 0.01687);
             d += x - x.trunc() - 0.5;
         }
-        Some((f64::from(leaf.value) * (1.0 + 1e-4 * d)) as f32)
+        let y = (f64::from(leaf.value) * (1.0 + 1e-4 * d)) as f32;
+        let (Some(u), Some(v)) = (&self.u, &self.v) else {
+            return Some(([y, 0.0, 0.0], 1));
+        };
+        let up = lookup_node(u, self.rank, &pos).value;
+        let vp = lookup_node(v, self.rank, &pos).value;
+        let rgb = yuv_to_sharp(f64::from(y), f64::from(up), f64::from(vp));
+        let w = XYZ_FROM_SHARP_F[1];
+        Some(([rgb[0] * w[0], rgb[1] * w[1], rgb[2] * w[2]], 3))
+    }
+
+    /// Splits a coloured Lambertian part off as Radiance does on loading: the per-channel
+    /// minima (Sharp RGB) over the Y tree's leaves (rank 3: the reachable half), each leaf's
+    /// colour averaged from the u′, v′ trees over the leaf; when their luminance lies above
+    /// 0.01/π it is subtracted from the Y tree and every u′ (v′) leaf is recoloured with the
+    /// minimum taken off (channels kept at least 1e-5 × the leaf's mean Y). Radiance skips the
+    /// unreachable leaves of a rank-3 u′/v′ tree while rebuilding it, which leaves the new tree
+    /// incomplete and drops it: the component is grey from then on.
+    fn split_colour(&mut self) -> Lambertian {
+        let none = Lambertian {
+            y: 0.0,
+            xyz: [0.0; 3],
+        };
+        let (Some(u), Some(v)) = (&self.u, &self.v) else {
+            return none;
+        };
+        let r = self.rank;
+        let dead = |cmin: &[f64; 4], csiz: f64| r == 3 && cmin[0] + 0.5 * csiz >= 0.5;
+        let upper = |cmin: &[f64; 4], csiz: f64| {
+            let mut cmax = *cmin;
+            for c in cmax.iter_mut().take(r) {
+                *c += csiz;
+            }
+            cmax
+        };
+        let mut min = [1e10f32; 3];
+        visit_leaves(&self.root, r, &[0.0; 4], 1.0, &mut |val, cmin, csiz| {
+            if dead(cmin, csiz) {
+                return;
+            }
+            let cmax = upper(cmin, csiz);
+            let rgb = yuv_to_sharp(
+                f64::from(val),
+                avg_box(u, r, cmin, &cmax),
+                avg_box(v, r, cmin, &cmax),
+            );
+            for c in 0..3 {
+                if rgb[c] < min[c] {
+                    min[c] = rgb[c];
+                }
+            }
+        });
+        let (ymin, cs) = from_sharp(min);
+        if ymin >= 0.5e10 || ymin <= 0.01 / PI {
+            return none;
+        }
+        // Recolour one chromaticity tree: `pick` gives the new coordinate of a remainder colour.
+        let recolour = |t: &Node, is_u: bool| -> Option<Node> {
+            let mut complete = true;
+            let node = map_leaves(t, r, &[0.0; 4], 1.0, &mut |val, cmin, csiz| {
+                if dead(cmin, csiz) {
+                    complete = false;
+                    return val;
+                }
+                let cmax = upper(cmin, csiz);
+                let yval = avg_box(&self.root, r, cmin, &cmax);
+                let mut rgb = if is_u {
+                    yuv_to_sharp(yval, f64::from(val), avg_box(v, r, cmin, &cmax))
+                } else {
+                    yuv_to_sharp(yval, avg_box(u, r, cmin, &cmax), f64::from(val))
+                };
+                for c in 0..3 {
+                    rgb[c] -= min[c];
+                    if f64::from(rgb[c]) < 1e-5 * yval {
+                        rgb[c] = (1e-5 * yval) as f32;
+                    }
+                }
+                let third = (1.0f64 / 3.0) as f32;
+                let (cx, cy) = from_sharp(rgb).1.unwrap_or((third, third));
+                let (cx, cy) = (f64::from(cx), f64::from(cy));
+                let d = -2.0 * cx + 12.0 * cy + 3.0;
+                (if is_u { 4.0 * cx / d } else { 9.0 * cy / d }) as f32
+            });
+            complete.then_some(node)
+        };
+        let new_u = recolour(u, true);
+        let new_v = recolour(v, false);
+        self.u = new_u;
+        self.v = new_v;
+        self.subtract(ymin as f32);
+        let third = (1.0f64 / 3.0) as f32;
+        let (cx, cy) = cs.unwrap_or((third, third));
+        let y = PI * ymin;
+        Lambertian {
+            y,
+            xyz: [
+                y * f64::from(cx) / f64::from(cy),
+                y,
+                y * f64::from(1.0f32 - cx - cy) / f64::from(cy),
+            ],
+        }
     }
 
     /// Projected solid angle of the leaf for a pair (`π·edge²`), or, without `b`, of the
@@ -308,6 +378,221 @@ impl Tree {
             }
         }
     }
+}
+
+/// The leaf of `node` (a tree of rank `rank`) at `pos`: value and hypercube, as Radiance's
+/// lookup finds it.
+fn lookup_node(node: &Node, r: usize, pos: &[f64; 4]) -> Leaf {
+    let mut p = *pos;
+
+    let mut corner = [0.0; 4];
+    let mut edge = 1.0;
+    let mut node = node;
+    loop {
+        match node {
+            Node::Branch(ch) => {
+                edge *= 0.5;
+                let mut n = 0;
+                for i in (0..r).rev() {
+                    let s = 2.0 * p[i];
+                    let t = usize::from(s >= 1.0);
+                    n |= t << i;
+                    p[i] = s - t as f64;
+                    corner[i] += t as f64 * edge;
+                }
+                node = &ch[n];
+            }
+            Node::Grid { log2, values } => {
+                if *log2 == 0 {
+                    return Leaf {
+                        value: values[0],
+                        corner,
+                        edge,
+                    };
+                }
+                let cells = (1u64 << log2) as f64;
+                let top = (1usize << log2) - 1;
+                let mut n = 0usize;
+                for v in &p[..r] {
+                    n = (n << log2) + ((cells * v) as usize).min(top);
+                }
+                edge /= cells;
+                for i in (0..r).rev() {
+                    corner[i] += (cells * p[i]).floor().min(top as f64) * edge;
+                }
+                return Leaf {
+                    value: values[n],
+                    corner,
+                    edge,
+                };
+            }
+        }
+    }
+}
+
+/// Sharp RGB (single precision) of luminance `y` and CIE (u′, v′), as Radiance converts it.
+fn yuv_to_sharp(y: f64, u: f64, v: f64) -> [f32; 3] {
+    let df = 1.0 / (6.0 * u - 16.0 * v + 12.0);
+    to_sharp(((9.0 * u * df) as f32, (4.0 * v * df) as f32), y)
+}
+
+/// Calls `f(value, lower corner, edge)` for every leaf of `node` (lower corner `cmin`, edge
+/// `csiz`).
+fn visit_leaves(
+    node: &Node,
+    r: usize,
+    cmin: &[f64; 4],
+    csiz: f64,
+    f: &mut dyn FnMut(f32, &[f64; 4], f64),
+) {
+    match node {
+        Node::Branch(ch) => {
+            let half = 0.5 * csiz;
+            for (n, c) in ch.iter().enumerate() {
+                let mut lo = *cmin;
+                for (i, l) in lo.iter_mut().enumerate().take(r) {
+                    if n >> i & 1 == 1 {
+                        *l += half;
+                    }
+                }
+                visit_leaves(c, r, &lo, half, f);
+            }
+        }
+        Node::Grid { log2, values } => {
+            let cells = 1usize << log2;
+            let cell = csiz / cells as f64;
+            for (k, &val) in values.iter().enumerate() {
+                f(val, &cell_corner(cmin, r, cells, cell, k), cell);
+            }
+        }
+    }
+}
+
+/// Lower corner of cell `k` (dimension 0 slowest) of a grid of `cells` per dimension and cell
+/// edge `cell` whose corner is `cmin`.
+fn cell_corner(cmin: &[f64; 4], r: usize, cells: usize, cell: f64, k: usize) -> [f64; 4] {
+    let mut lo = *cmin;
+    for (i, l) in lo.iter_mut().enumerate().take(r) {
+        let ci = k / cells.pow((r - 1 - i) as u32) % cells;
+        *l += cell * ci as f64;
+    }
+    lo
+}
+
+/// `node` with every leaf value replaced by `f(value, lower corner, edge)`.
+fn map_leaves(
+    node: &Node,
+    r: usize,
+    cmin: &[f64; 4],
+    csiz: f64,
+    f: &mut dyn FnMut(f32, &[f64; 4], f64) -> f32,
+) -> Node {
+    match node {
+        Node::Branch(ch) => {
+            let half = 0.5 * csiz;
+            let mut out = Vec::with_capacity(ch.len());
+            for (n, c) in ch.iter().enumerate() {
+                let mut lo = *cmin;
+                for (i, l) in lo.iter_mut().enumerate().take(r) {
+                    if n >> i & 1 == 1 {
+                        *l += half;
+                    }
+                }
+                out.push(map_leaves(c, r, &lo, half, f));
+            }
+            Node::Branch(out)
+        }
+        Node::Grid { log2, values } => {
+            let cells = 1usize << log2;
+            let cell = csiz / cells as f64;
+            let values = values
+                .iter()
+                .enumerate()
+                .map(|(k, &val)| f(val, &cell_corner(cmin, r, cells, cell, k), cell))
+                .collect();
+            Node::Grid {
+                log2: *log2,
+                values,
+            }
+        }
+    }
+}
+
+/// Radiance's average of a tree's leaves over the box `[bmin, bmax)` (overlap-weighted over
+/// branches, a plain mean over the grid cells the box touches).
+fn avg_box(node: &Node, r: usize, bmin: &[f64; 4], bmax: &[f64; 4]) -> f64 {
+    for i in 0..r {
+        if bmin[i] >= 1.0 || bmax[i] <= 0.0 || bmin[i] >= bmax[i] {
+            return 0.0;
+        }
+    }
+    match node {
+        Node::Branch(ch) => {
+            let (mut sum, mut wsum) = (0.0, 1e-20);
+            for n in (0..ch.len()).rev() {
+                let (mut lo, mut hi) = ([0.0; 4], [0.0; 4]);
+                let mut w = 1.0;
+                for i in (0..r).rev() {
+                    lo[i] = 2.0 * bmin[i];
+                    hi[i] = 2.0 * bmax[i];
+                    if n >> i & 1 == 1 {
+                        lo[i] -= 1.0;
+                        hi[i] -= 1.0;
+                    }
+                    lo[i] = lo[i].max(0.0);
+                    hi[i] = hi[i].min(1.0);
+                    if lo[i] >= hi[i] {
+                        w = 0.0;
+                        break;
+                    }
+                    w *= hi[i] - lo[i];
+                }
+                if w > 1e-10 {
+                    sum += w * avg_box(&ch[n], r, &lo, &hi);
+                    wsum += w;
+                }
+            }
+            sum / wsum
+        }
+        Node::Grid { log2, values } => {
+            let cells = 1usize << log2;
+            let (mut imin, mut imax) = ([0usize; 4], [0usize; 4]);
+            let mut n = 1;
+            for i in (0..r).rev() {
+                imin[i] = if bmin[i] <= 0.0 {
+                    0
+                } else {
+                    (cells as f64 * bmin[i]) as usize
+                };
+                imax[i] = if bmax[i] >= 1.0 {
+                    cells
+                } else {
+                    (cells as f64 * bmax[i] + 0.999999) as usize
+                };
+                n *= imax[i] - imin[i];
+            }
+            if n == 0 {
+                return 0.0;
+            }
+            iter_sum(values, r, *log2, &imin[..r], &imax[..r]) / n as f64
+        }
+    }
+}
+
+/// Sum of a grid's values over an index box, in Radiance's order (dimension 0 outermost).
+fn iter_sum(va: &[f32], nd: usize, log2: u32, imin: &[usize], imax: &[usize]) -> f64 {
+    let skip = 1usize << ((nd - 1) as u32 * log2);
+    let mut sum = 0.0;
+    if skip == 1 {
+        for &v in &va[imin[0]..imax[0]] {
+            sum += f64::from(v);
+        }
+    } else {
+        for i in imin[0]..imax[0] {
+            sum += iter_sum(&va[i * skip..], nd - 1, log2, &imin[1..], &imax[1..]);
+        }
+    }
+    sum
 }
 
 /// Rotation about z by `theta` (Radiance's `spinvector` with the z axis).
@@ -397,8 +682,10 @@ impl Loaded {
             (self.t_lamb_back, self.tb.as_ref().or(self.tf.as_ref()))
         };
         let mut y = lamb * (1.0 / PI);
-        if let Some(v) = tree.and_then(|t| t.value(out, inc)) {
-            y += f64::from(v);
+        if let Some((c, n)) = tree.and_then(|t| t.coefs(out, inc)) {
+            for v in c[..n].iter().rev() {
+                y += f64::from(*v);
+            }
         }
         y
     }
@@ -620,100 +907,182 @@ fn parse_tree(rank: usize, text: &str) -> Result<Node, String> {
     Ok(root)
 }
 
-/// Radiance's three reciprocity rows (Interior Refl, Exterior Refl, Transmission) for a
-/// grey tensor-tree file, drawing from `rng`. `xml` is the file's text; `max_totals` the largest
-/// directional totals of XML `Reflection Back`, `Reflection Front`, `Transmission Back` and
-/// `Transmission Front` as the component table gives them (Radiance drops a component with at
-/// most 0.001 left after its Lambertian part). `Ok(None)` for files this does not cover (Klems
-/// matrices, coloured trees: CIE-u/v blocks).
+/// A Lambertian part split off on loading: CIE Y and XYZ as hemispherical fractions.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Lambertian {
+    /// π × the Y value split off.
+    pub y: f64,
+    /// CIE X, Y, Z (grey: all equal to `y`).
+    pub xyz: [f64; 3],
+}
+
+/// A tensor-tree file as Radiance's BSDF library holds it after loading: the `Visible` trees
+/// (and CIE-u/v trees of coloured components) of Radiance's rf, rb, tf, tb (XML
+/// `Reflection Back`, `Reflection Front`, `Transmission Back`, `Transmission Front`) with their
+/// Lambertian parts split off.
+pub struct TreeFile {
+    rank: usize,
+    trees: [Option<Tree>; 4],
+    lamb: [Lambertian; 4],
+}
+
+impl TreeFile {
+    /// Loads the trees of a tensor-tree BSDF file's text; `Ok(None)` for other files.
+    pub fn load(xml: &str) -> Result<Option<TreeFile>, String> {
+        let root = crate::dom::parse(xml).map_err(|(m, p)| format!("{m} (byte {p})"))?;
+        let Some(layer) = root.child("Optical").and_then(|o| o.child("Layer")) else {
+            return Ok(None);
+        };
+        let rank = match layer
+            .child("DataDefinition")
+            .and_then(|d| d.child_text("IncidentDataStructure"))
+            .map(str::to_ascii_lowercase)
+            .as_deref()
+        {
+            Some("tensortree3") => 3,
+            Some("tensortree4") => 4,
+            _ => return Ok(None),
+        };
+        // Per component (rf, rb, tf, tb): Visible, CIE-u, CIE-v trees.
+        let mut nodes: [[Option<Node>; 3]; 4] = Default::default();
+        for wd in layer.children_named("WavelengthData") {
+            let wl = wd
+                .child_text("Wavelength")
+                .unwrap_or("")
+                .to_ascii_lowercase();
+            let ct = match wl.as_str() {
+                "visible" => 0,
+                "cie-u" => 1,
+                "cie-v" => 2,
+                _ => continue,
+            };
+            for blk in wd.children_named("WavelengthDataBlock") {
+                let Some(d) = blk
+                    .child_text("WavelengthDataDirection")
+                    .and_then(Direction::parse)
+                else {
+                    continue;
+                };
+                let text = blk.child("ScatteringData").map_or("", |e| e.text.as_str());
+                let node = parse_tree(rank, text).map_err(|e| format!("{}: {e}", d.xml_name()))?;
+                nodes[slot(d)][ct] = Some(node);
+            }
+        }
+        let sides = [
+            Side::FrontRefl,
+            Side::BackRefl,
+            Side::FrontTrans,
+            Side::BackTrans,
+        ];
+        let mut k = 0;
+        let mut trees = nodes.map(|[y, u, v]| {
+            let side = sides[k];
+            k += 1;
+            y.map(|root| Tree {
+                rank,
+                side,
+                root,
+                u,
+                v,
+            })
+        });
+        let none = Lambertian {
+            y: 0.0,
+            xyz: [0.0; 3],
+        };
+        let mut lamb = [none; 4];
+        for (t, l) in trees.iter_mut().zip(lamb.iter_mut()) {
+            if let Some(t) = t {
+                *l = if t.u.is_some() && t.v.is_some() {
+                    t.split_colour()
+                } else {
+                    let y = t.split_lambertian();
+                    Lambertian { y, xyz: [y; 3] }
+                };
+            }
+        }
+        // One Lambertian transmission copied to the side without a tree.
+        match (trees[2].is_some(), trees[3].is_some()) {
+            (false, true) => lamb[2] = lamb[3],
+            (true, false) => lamb[3] = lamb[2],
+            _ => {}
+        }
+        Ok(Some(TreeFile { rank, trees, lamb }))
+    }
+
+    /// The Lambertian parts split off XML `Reflection Back`, `Reflection Front`,
+    /// `Transmission Back`, `Transmission Front` (a missing transmission shows the other's).
+    pub fn lambertians(&self) -> [Lambertian; 4] {
+        self.lamb
+    }
+
+    /// Whether a component has colour trees (CIE-u/v).
+    pub fn has_colour(&self) -> bool {
+        self.trees
+            .iter()
+            .flatten()
+            .any(|t| t.u.is_some() || t.v.is_some())
+    }
+
+    /// Radiance's `Color:` flag: the u′ tree of the first component kept among XML
+    /// `Transmission Front`, `Transmission Back`, `Reflection Back`, `Reflection Front` (see
+    /// [`TreeFile::rows`] for `max_totals`).
+    pub fn colour_flag(&self, max_totals: [Option<f64>; 4]) -> bool {
+        [3, 2, 0, 1]
+            .into_iter()
+            .find(|&k| self.kept(k, &max_totals))
+            .and_then(|k| self.trees[k].as_ref())
+            .is_some_and(|t| t.u.is_some())
+    }
+
+    fn kept(&self, k: usize, max_totals: &[Option<f64>; 4]) -> bool {
+        self.trees[k].is_some() && max_totals[k].is_some_and(|m| m - self.lamb[k].y > 0.001)
+    }
+
+    /// Radiance's three reciprocity rows (Interior Refl, Exterior Refl, Transmission), drawing
+    /// from `rng`. `max_totals`: the largest directional totals of XML `Reflection Back`,
+    /// `Reflection Front`, `Transmission Back`, `Transmission Front` as the component table gives
+    /// them (Radiance drops a component with at most 0.001 left after its Lambertian part).
+    pub fn rows(self, max_totals: [Option<f64>; 4], rng: &mut Drand48) -> [SampledRow; 3] {
+        let keep: [bool; 4] = std::array::from_fn(|k| self.kept(k, &max_totals));
+        let [rf, rb, tf, tb] = self.trees;
+        let pick = |t: Option<Tree>, k: usize| t.filter(|_| keep[k]);
+        let loaded = Loaded {
+            rank: self.rank,
+            rf: pick(rf, 0),
+            rb: pick(rb, 1),
+            tf: pick(tf, 2),
+            tb: pick(tb, 3),
+            r_lamb_front: self.lamb[0].y,
+            r_lamb_back: self.lamb[1].y,
+            t_lamb_front: self.lamb[2].y,
+            t_lamb_back: self.lamb[3].y,
+        };
+        [
+            loaded.row(rng, 1.0, 1.0),
+            loaded.row(rng, -1.0, -1.0),
+            loaded.row(rng, -1.0, 1.0),
+        ]
+    }
+}
+
+/// Index of an XML direction in Radiance's rf, rb, tf, tb order.
+fn slot(d: Direction) -> usize {
+    match d {
+        Direction::ReflectionBack => 0,
+        Direction::ReflectionFront => 1,
+        Direction::TransmissionBack => 2,
+        Direction::TransmissionFront => 3,
+    }
+}
+
+/// [`TreeFile::load`] then [`TreeFile::rows`]: `Ok(None)` for files that are not tensor trees.
 pub fn tree_rows(
     xml: &str,
     max_totals: [Option<f64>; 4],
     rng: &mut Drand48,
 ) -> Result<Option<[SampledRow; 3]>, String> {
-    let root = crate::dom::parse(xml).map_err(|(m, p)| format!("{m} (byte {p})"))?;
-    let Some(layer) = root.child("Optical").and_then(|o| o.child("Layer")) else {
-        return Ok(None);
-    };
-    let rank = match layer
-        .child("DataDefinition")
-        .and_then(|d| d.child_text("IncidentDataStructure"))
-        .map(str::to_ascii_lowercase)
-        .as_deref()
-    {
-        Some("tensortree3") => 3,
-        Some("tensortree4") => 4,
-        _ => return Ok(None),
-    };
-    let mut trees: [Option<Tree>; 4] = [None, None, None, None];
-    for wd in layer.children_named("WavelengthData") {
-        let wl = wd
-            .child_text("Wavelength")
-            .unwrap_or("")
-            .to_ascii_lowercase();
-        if wl == "cie-u" || wl == "cie-v" {
-            return Ok(None);
-        }
-        if wl != "visible" {
-            continue;
-        }
-        for blk in wd.children_named("WavelengthDataBlock") {
-            let Some(d) = blk
-                .child_text("WavelengthDataDirection")
-                .and_then(Direction::parse)
-            else {
-                continue;
-            };
-            let text = blk.child("ScatteringData").map_or("", |e| e.text.as_str());
-            let node = parse_tree(rank, text).map_err(|e| format!("{}: {e}", d.xml_name()))?;
-            let (k, side) = match d {
-                Direction::ReflectionBack => (0, Side::FrontRefl),
-                Direction::ReflectionFront => (1, Side::BackRefl),
-                Direction::TransmissionBack => (2, Side::FrontTrans),
-                Direction::TransmissionFront => (3, Side::BackTrans),
-            };
-            trees[k] = Some(Tree {
-                rank,
-                side,
-                root: node,
-            });
-        }
-    }
-    let [mut rf, mut rb, mut tf, mut tb] = trees;
-    let lamb = |t: &mut Option<Tree>| t.as_mut().map_or(0.0, Tree::split_lambertian);
-    let r_lamb_front = lamb(&mut rf);
-    let r_lamb_back = lamb(&mut rb);
-    let mut t_lamb_front = lamb(&mut tf);
-    let mut t_lamb_back = 0.0;
-    if tb.is_some() {
-        t_lamb_back = lamb(&mut tb);
-        if tf.is_none() {
-            t_lamb_front = t_lamb_back;
-        }
-    } else if tf.is_some() {
-        t_lamb_back = t_lamb_front;
-    }
-    // Radiance drops components whose largest directional total (Lambertian part removed) is
-    // at most 0.001.
-    let keep = |t: Option<Tree>, k: usize, l: f64| {
-        t.filter(|_| max_totals[k].is_some_and(|m| m - l > 0.001))
-    };
-    let loaded = Loaded {
-        rank,
-        rf: keep(rf, 0, r_lamb_front),
-        rb: keep(rb, 1, r_lamb_back),
-        tf: keep(tf, 2, t_lamb_front),
-        tb: keep(tb, 3, t_lamb_back),
-        r_lamb_front,
-        r_lamb_back,
-        t_lamb_front,
-        t_lamb_back,
-    };
-    Ok(Some([
-        loaded.row(rng, 1.0, 1.0),
-        loaded.row(rng, -1.0, -1.0),
-        loaded.row(rng, -1.0, 1.0),
-    ]))
+    Ok(TreeFile::load(xml)?.map(|f| f.rows(max_totals, rng)))
 }
 
 #[cfg(test)]
@@ -788,6 +1157,8 @@ mod tests {
             rank: 3,
             side: Side::FrontRefl,
             root: node,
+            u: None,
+            v: None,
         };
         // Only children 0, 2, 4, 6 (lower half of dimension 0) count: minimum 0.1, subtracted
         // in float.
