@@ -1179,24 +1179,23 @@ impl Tracer {
         };
         let td = b.td;
         let side = if front { z } else { -z };
-        let mut val = self.direct(
-            r,
-            p,
-            side,
-            Some(shape),
-            DVec3::ZERO,
-            cx,
-            |l, omega, ldot| {
-                let ll = to_local(l);
-                let same = (ll.z > 0.0) == front;
-                let f = if same {
-                    DVec3::splat(refl.map_or(0.0, |c| c.eval(v, ll))) + rd / PI
-                } else {
-                    DVec3::splat(trans.map_or(0.0, |c| c.eval(v, ll))) + td / PI
-                };
-                f * (ldot.abs() * omega)
-            },
-        );
+        let lobe = |l: DVec3, omega: f64, ldot: f64| {
+            let ll = to_local(l);
+            let same = (ll.z > 0.0) == front;
+            let f = if same {
+                DVec3::splat(refl.map_or(0.0, |c| c.eval(v, ll))) + rd / PI
+            } else {
+                DVec3::splat(trans.map_or(0.0, |c| c.eval(v, ll))) + td / PI
+            };
+            f * (ldot.abs() * omega)
+        };
+        // with thresholding direct light comes last (as in Radiance), otherwise first
+        let last = cx.ds.is_some();
+        let mut val = if last {
+            DVec3::ZERO
+        } else {
+            self.direct(r, p, side, Some(shape), DVec3::ZERO, cx, lobe)
+        };
         for (comp, flag) in [(refl, REFLECTED), (trans, TRANS)] {
             let Some(c) = comp else { continue };
             let (u, u0, u1) = (cx.rng.next_f64(), cx.rng.next_f64(), cx.rng.next_f64());
@@ -1210,6 +1209,9 @@ impl Tracer {
         }
         if maxc(td) > FTINY {
             val += self.ambient(r, p, -side, td, Some(shape), cx);
+        }
+        if last {
+            val += self.direct(r, p, side, Some(shape), val, cx, lobe);
         }
         val
     }
