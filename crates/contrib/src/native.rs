@@ -16,7 +16,7 @@ pub const KLEMS_FULL_CAL: &str = include_str!("../../../lib/klems_full.cal");
 pub const REINHART_CAL: &str = include_str!("../../../lib/reinhart.cal");
 
 /// Names whose (re)definition outside the shipped file disables the native path.
-pub const KLEMS_NAMES: [&str; 22] = [
+pub const KLEMS_NAMES: [&str; 24] = [
     "kf_deg",
     "kf_c5",
     "kf_c15",
@@ -29,6 +29,8 @@ pub const KLEMS_NAMES: [&str; 22] = [
     "kf_c90",
     "kf_t",
     "kf_dot",
+    "kf_nz",
+    "kf_dotu",
     "kf_wrapped",
     "kf_p",
     "kf_bin",
