@@ -121,6 +121,22 @@ fn oracle_thresholding_without_the_obstructor_cache() {
     agree(&oracle, &dir, &points(), 0.005);
 }
 
+#[test]
+fn oracle_thresholding_with_a_sun_among_the_lamps() {
+    // a distant source (its own obstructor-cache layout) ranked among the lamps: its
+    // direct irradiance on the points is of the order of the brightest lamps'
+    let Some(oracle) = common::oracle() else {
+        return;
+    };
+    let dir = common::scratch("dt_sun_lamps");
+    let mut scene = std::fs::read_to_string(common::fixture(FIXTURE).join("scene.rad")).unwrap();
+    scene.push_str(
+        "void light solar 0 0 3 3e3 3e3 3e3\nsolar source sun 0 0 4 0.45 0.3 0.84 0.533\n",
+    );
+    std::fs::write(dir.join("scene.rad"), scene).unwrap();
+    agree(&oracle, &dir, &points(), 0.01);
+}
+
 fn run(dir: &Path, opts: &[&str], rays: &str) -> (Vec<u8>, String) {
     let mut c = common::fenestra("rtrace");
     c.args(opts).arg("scene.rad").current_dir(dir);
