@@ -55,7 +55,10 @@ pub(super) struct Candidate {
     tmax: f64,
     coef: DVec3,
     val: DVec3,
+    /// Brightness of `val`, in single precision as Radiance keeps its sort keys and their
+    /// running tail sums (a threshold decision near a tie then goes the same way).
     brt: f32,
+    /// Its source has only this sample here (obstructor-cache lookups and records).
     single: bool,
 }
 
