@@ -243,45 +243,28 @@ pub fn tree_component(b: &Bsdf, d: Direction) -> Option<ComponentCheck> {
     let cell = t.finest_cell();
     let n = (1.0 / cell).round().max(1.0) as usize;
     let c = |k: usize| (k as f64 + 0.5) / n as f64;
-    // Smallest value over the part of the tree that directions reach (rank 3 uses only the
-    // lower half of its incident dimension).
-    let min = if t.rank() == 3 {
-        let mut m = f64::INFINITY;
-        for j in 0..n.div_ceil(2) {
-            for a in 0..n {
-                for bb in 0..n {
-                    m = m.min(t.lookup(&[c(j), c(a), c(bb)]));
-                }
-            }
-        }
-        m
-    } else {
-        t.min_value()
-    };
-    // Radiance splits nothing off a tree whose minimum reaches TREE_LAMBERTIAN_MAX.
-    let split = min > LAMBERTIAN_MIN && min < TREE_LAMBERTIAN_MAX;
-    let y = if split {
-        std::f64::consts::PI * min
-    } else {
-        0.0
-    };
-    let hemi = |inc: &[f64]| -> f64 {
+    // Directional totals per incident cell on the finest grid (rank 3: incident position
+    // 0.5 − r/2 covers [0, 0.5): r = 1 (grazing) … 0 (normal)); for rank 3 the same lookups
+    // give the smallest value over the part of the tree that directions reach.
+    let mut min3 = f64::INFINITY;
+    let mut hemi = |inc: &[f64]| -> f64 {
         let mut sum = 0.0;
-        let mut pos = inc.to_vec();
-        pos.extend_from_slice(&[0.0, 0.0]);
+        let mut pos = [0.0; 4];
         let r = inc.len();
+        pos[..r].copy_from_slice(inc);
         for a in 0..n {
             for bb in 0..n {
                 pos[r] = c(a);
                 pos[r + 1] = c(bb);
-                sum += t.lookup(&pos);
+                let v = t.lookup(&pos[..r + 2]);
+                min3 = min3.min(v);
+                sum += v;
             }
         }
         std::f64::consts::PI * sum / (n * n) as f64
     };
     let mut totals = Vec::new();
     if t.rank() == 3 {
-        // Incident position 0.5 − r/2 covers [0, 0.5): r = 1 (grazing) … 0 (normal).
         for j in 0..n.div_ceil(2) {
             totals.push(hemi(&[c(j)]));
         }
@@ -292,12 +275,17 @@ pub fn tree_component(b: &Bsdf, d: Direction) -> Option<ComponentCheck> {
             }
         }
     }
-    let max_total = totals.iter().copied().fold(0.0, f64::max);
-    let normal_total = if t.rank() == 3 {
-        totals.last().copied().unwrap_or(0.0)
+    let normal_rank4 = (t.rank() == 4).then(|| hemi(&[0.5, 0.5]));
+    let min = if t.rank() == 3 { min3 } else { t.min_value() };
+    // Radiance splits nothing off a tree whose minimum reaches TREE_LAMBERTIAN_MAX.
+    let split = min > LAMBERTIAN_MIN && min < TREE_LAMBERTIAN_MAX;
+    let y = if split {
+        std::f64::consts::PI * min
     } else {
-        hemi(&[0.5, 0.5])
+        0.0
     };
+    let max_total = totals.iter().copied().fold(0.0, f64::max);
+    let normal_total = normal_rank4.unwrap_or_else(|| totals.last().copied().unwrap_or(0.0));
     // Diffuse incidence: incident cells weighted by their projected solid angle (uniform in
     // the square for rank 4; for rank 3 the cell j covers radii r in [1 − 2(j+1)/n, 1 − 2j/n]).
     let diffuse_total = if t.rank() == 3 {

@@ -64,9 +64,15 @@ struct Tree {
     /// component has a Lambertian part split off, see [`Tree::split_colour`]).
     u: Option<Node>,
     v: Option<Node>,
+    /// The last pair looked up (oriented directions, tree position, leaf): the sampling asks for
+    /// the same pair twice in a row (cell size, then one of the two values).
+    memo: Memo,
 }
 
+type Memo = std::cell::Cell<Option<([f64; 3], [f64; 3], [f64; 4], Leaf)>>;
+
 /// A leaf found by a lookup: its value and its hypercube (lower corner, edge).
+#[derive(Clone, Copy, Debug)]
 struct Leaf {
     value: f32,
     corner: [f64; 4],
@@ -190,12 +196,25 @@ impl Tree {
 
     /// The leaf for the pair `(a, b)` in Radiance's tree-query order.
     fn query(&self, a: [f64; 3], b: [f64; 3]) -> Option<Leaf> {
-        Some(self.lookup(&self.position(a, b)?))
+        Some(self.locate(a, b)?.1)
     }
 
-    /// Tree coordinates of the pair `(a, b)` in Radiance's tree-query order.
-    fn position(&self, a: [f64; 3], b: [f64; 3]) -> Option<[f64; 4]> {
+    /// Tree position and leaf of the pair `(a, b)` in Radiance's tree-query order.
+    fn locate(&self, a: [f64; 3], b: [f64; 3]) -> Option<([f64; 4], Leaf)> {
         let (i, o) = self.orient(a, b)?;
+        if let Some((mi, mo, pos, leaf)) = self.memo.get() {
+            if mi == i && mo == o {
+                return Some((pos, leaf));
+            }
+        }
+        let pos = self.position(i, o);
+        let leaf = self.lookup(&pos);
+        self.memo.set(Some((i, o, pos, leaf)));
+        Some((pos, leaf))
+    }
+
+    /// Tree coordinates of the oriented pair (`i` where the tree's light comes from).
+    fn position(&self, i: [f64; 3], o: [f64; 3]) -> [f64; 4] {
         let mut pos = [0.0; 4];
         if self.rank == 3 {
             let theta = -(-i[1]).atan2(-i[0]);
@@ -209,7 +228,7 @@ impl Tree {
             let (s, t) = disk_to_square(o[0], o[1]);
             pos = [u, v, s, t];
         }
-        Some(pos)
+        pos
     }
 
     /// The tree's BSDF value for the pair as Radiance returns it (float, with its
@@ -217,8 +236,7 @@ impl Tree {
     /// The tree's BSDF coefficients for the pair as Radiance returns them: one (grey) or three
     /// (Sharp RGB weighted by the primaries' luminances, from the value and the u′, v′ trees).
     fn coefs(&self, a: [f64; 3], b: [f64; 3]) -> Option<([f32; 3], usize)> {
-        let pos = self.position(a, b)?;
-        let leaf = self.lookup(&pos);
+        let (pos, leaf) = self.locate(a, b)?;
         let mut d = 0.0;
         for i in (0..self.rank).rev() {
             let x = f64::from(2u32 << i) / (leaf.corner[i] + 0.01687);
@@ -984,6 +1002,7 @@ impl TreeFile {
                 root,
                 u,
                 v,
+                memo: Memo::default(),
             })
         });
         let none = Lambertian {
@@ -1159,6 +1178,7 @@ mod tests {
             root: node,
             u: None,
             v: None,
+            memo: Memo::default(),
         };
         // Only children 0, 2, 4, 6 (lower half of dimension 0) count: minimum 0.1, subtracted
         // in float.
