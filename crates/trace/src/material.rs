@@ -72,8 +72,10 @@ pub enum LightKind {
     Glow(f64),
     /// `illum` with its alternate material (scene prim index) if any.
     Illum(Option<usize>),
-    /// `spotlight`: cosine of the half cone angle and aim direction (unit).
-    Spot(f64, DVec3),
+    /// `spotlight`: cosine of the half cone angle, aim direction (unit) and focal length
+    /// (the length of the given direction vector: the light comes from a point that far
+    /// behind the source, which scales a sample's solid angle by d²/(d + focal length)²).
+    Spot(f64, DVec3, f64),
 }
 
 impl Material {
@@ -202,10 +204,18 @@ pub fn compile(scene: &Scene, i: usize) -> Result<Material> {
         "spotlight" => {
             need(p, 7)?;
             let half = (p.rargs[3] * 0.5).to_radians();
-            let aim = DVec3::new(p.rargs[4], p.rargs[5], p.rargs[6]).normalize_or_zero();
+            let dir = DVec3::new(p.rargs[4], p.rargs[5], p.rargs[6]);
+            let flen = dir.length();
+            if flen == 0.0 || !flen.is_finite() {
+                bail!(
+                    "{}: spotlight '{}': zero direction (focus) vector",
+                    p.loc,
+                    p.name
+                );
+            }
             Material::Light {
                 color: rgb(p),
-                kind: LightKind::Spot(half.cos(), aim),
+                kind: LightKind::Spot(half.cos(), dir / flen, flen),
             }
         }
         "antimatter" => {

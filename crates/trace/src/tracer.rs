@@ -1123,7 +1123,7 @@ impl Tracer {
         if rod < 0.0 {
             return (DVec3::ZERO, false);
         }
-        if let LightKind::Spot(cosang, aim) = kind {
+        if let LightKind::Spot(cosang, aim, _) = kind {
             if (-r.dir).dot(*aim) < *cosang {
                 return (DVec3::ZERO, false);
             }
@@ -1528,12 +1528,16 @@ impl Tracer {
                 if Some(sh) == shape {
                     return;
                 }
-                let maxrad = match &self.mats[&s.mat] {
+                let (maxrad, focus) = match &self.mats[&s.mat] {
                     Material::Light {
                         kind: LightKind::Glow(rad),
                         ..
-                    } => *rad,
-                    _ => f64::INFINITY,
+                    } => (*rad, 0.0),
+                    Material::Light {
+                        kind: LightKind::Spot(_, _, flen),
+                        ..
+                    } => (f64::INFINITY, *flen),
+                    _ => (f64::INFINITY, 0.0),
                 };
                 let mut emit = |cx: &mut Ctx, q: DVec3, omega: f64, count: usize| {
                     let v = q - p;
@@ -1541,6 +1545,13 @@ impl Tracer {
                     if dist <= 0.0 || dist > maxrad || omega <= 0.0 {
                         return;
                     }
+                    // a spotlight's light comes from its focus, `focus` behind the source
+                    // (Radiance scales the sample's solid angle so)
+                    let omega = if focus > 0.0 {
+                        omega * (dist / (dist + focus)).powi(2)
+                    } else {
+                        omega
+                    };
                     f(
                         cx,
                         SourceSample {
