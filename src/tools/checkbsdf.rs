@@ -12,7 +12,7 @@ use anyhow::{anyhow, bail, Result};
 use fenestra_bsdf::check::sampled::{SampledRow, TreeFile};
 use fenestra_bsdf::check::{self, ComponentCheck, Reciprocity};
 use fenestra_bsdf::radiance::Drand48;
-use fenestra_bsdf::{BlockData, Bsdf, Direction, Wavelength};
+use fenestra_bsdf::{BlockData, Bsdf, Direction};
 use fenestra_cli::opts::{Item, Spec};
 use fenestra_formats::matrix::format_c_g;
 
@@ -107,38 +107,23 @@ fn report(
     rng: &mut Drand48,
 ) -> Result<String> {
     let mut s = String::new();
-    let tree = b
-        .blocks
-        .iter()
-        .any(|blk| matches!(blk.data, BlockData::Tree(_)) && blk.wavelength == Wavelength::Visible);
-    let comp = |d| {
-        if tree {
-            check::tree_component(b, d)
-        } else {
-            check::component_with(b, d, colour)
-        }
+    let comp = |d| match &trees {
+        Some(t) => t.component(match d {
+            Direction::ReflectionBack => 0,
+            Direction::ReflectionFront => 1,
+            Direction::TransmissionBack => 2,
+            Direction::TransmissionFront => 3,
+        }),
+        None => check::component_with(b, d, colour),
     };
-    let (mut rf, mut rb) = (
+    let (rf, rb) = (
         comp(Direction::ReflectionBack),
         comp(Direction::ReflectionFront),
     );
-    let (mut tf, mut tb) = (
+    let (tf, tb) = (
         comp(Direction::TransmissionBack),
         comp(Direction::TransmissionFront),
     );
-    // Tensor trees: the Lambertian parts as Radiance splits them on loading (grey: π × the
-    // reachable minimum; coloured: per-channel Sharp RGB minima).
-    if let Some(t) = &trees {
-        for (c, l) in [&mut rf, &mut rb, &mut tf, &mut tb]
-            .into_iter()
-            .zip(t.lambertians())
-        {
-            if let Some(c) = c {
-                c.lambertian_xyz = l.xyz;
-                c.lambertian_y = l.y / std::f64::consts::PI;
-            }
-        }
-    }
     let totals = [&rf, &rb, &tf, &tb].map(|c| c.as_ref().map(|c| c.max_total));
     // Radiance drops a component whose largest directional total, its Lambertian part removed,
     // is at most 0.001; the split-off part still prints (as a missing transmission's).

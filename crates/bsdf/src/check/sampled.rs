@@ -171,6 +171,73 @@ impl Tree {
         PI * f64::from(vmin)
     }
 
+    /// Directional-hemispherical total at normal incidence: π × the mean over the outgoing
+    /// square of the slice at incident position 0.5 − 1e-6 (rank 3) or (0.5, 0.5) (rank 4).
+    fn normal_total(&self) -> f64 {
+        let r = self.rank;
+        let at = if r == 3 {
+            [0.5 - FTINY, 0.0]
+        } else {
+            [0.5, 0.5]
+        };
+        let nin = r - 2;
+        let mut sum = 0.0;
+        visit_leaves(&self.root, r, &[0.0; 4], 1.0, &mut |val, cmin, csiz| {
+            let inside = (0..nin).all(|i| cmin[i] <= at[i] && at[i] < cmin[i] + csiz);
+            if inside {
+                sum += f64::from(val) * csiz * csiz;
+            }
+        });
+        PI * sum
+    }
+
+    /// Hemispherical total for uniform diffuse incidence: incident positions weighted by their
+    /// projected solid angle (rank 4: uniform over the square; rank 3: position x covers radius
+    /// 1 − 2x, so a leaf over [a, b) weighs r(a)² − r(b)²).
+    fn diffuse_total(&self) -> f64 {
+        let r = self.rank;
+        let mut sum = 0.0;
+        visit_leaves(&self.root, r, &[0.0; 4], 1.0, &mut |val, cmin, csiz| {
+            let w = if r == 4 {
+                csiz * csiz
+            } else {
+                let rad = |x: f64| (1.0 - 2.0 * x).clamp(0.0, 1.0);
+                let (ra, rb) = (rad(cmin[0]), rad(cmin[0] + csiz));
+                ra * ra - rb * rb
+            };
+            sum += f64::from(val) * csiz * csiz * w;
+        });
+        PI * sum
+    }
+
+    /// Radiance's largest directional-hemispherical total (see [`TreeFile::max_totals`]).
+    fn max_hemi(&self) -> f64 {
+        let step = self.smallest_leaf().max(0.03125);
+        let mut best = 0.0f64;
+        let (mut lo, mut hi) = ([0.0, 0.0, 0.0, 0.0], [1.0; 4]);
+        if self.rank == 3 {
+            lo[0] = 0.0;
+            while lo[0] < 0.5 - FTINY {
+                hi[0] = lo[0] + step;
+                best = best.max(avg_box(&self.root, 3, &lo, &hi));
+                lo[0] += step;
+            }
+        } else {
+            lo[0] = 0.0;
+            while lo[0] < 1.0 - FTINY {
+                hi[0] = lo[0] + step;
+                lo[1] = 0.0;
+                while lo[1] < 1.0 - FTINY {
+                    hi[1] = lo[1] + step;
+                    best = best.max(avg_box(&self.root, 4, &lo, &hi));
+                    lo[1] += step;
+                }
+                lo[0] += step;
+            }
+        }
+        best * PI
+    }
+
     /// Orders a direction pair for this tree (`a` where light comes from as Radiance's tree
     /// query names it); `None` when the pair is not on this component's sides.
     fn orient(&self, a: [f64; 3], b: [f64; 3]) -> Option<([f64; 3], [f64; 3])> {
@@ -942,6 +1009,10 @@ pub struct TreeFile {
     rank: usize,
     trees: [Option<Tree>; 4],
     lamb: [Lambertian; 4],
+    max_hemi: [Option<f64>; 4],
+    /// Per component: (directional total at normal incidence, total for diffuse incidence,
+    /// smallest leaf), from the tree before its Lambertian part was split off.
+    totals: [Option<(f64, f64, f64)>; 4],
 }
 
 impl TreeFile {
@@ -1009,6 +1080,12 @@ impl TreeFile {
             y: 0.0,
             xyz: [0.0; 3],
         };
+        let max_hemi = std::array::from_fn(|k| trees[k].as_ref().map(Tree::max_hemi));
+        let totals = std::array::from_fn(|k| {
+            trees[k]
+                .as_ref()
+                .map(|t| (t.normal_total(), t.diffuse_total(), t.smallest_leaf()))
+        });
         let mut lamb = [none; 4];
         for (t, l) in trees.iter_mut().zip(lamb.iter_mut()) {
             if let Some(t) = t {
@@ -1026,13 +1103,46 @@ impl TreeFile {
             (true, false) => lamb[3] = lamb[2],
             _ => {}
         }
-        Ok(Some(TreeFile { rank, trees, lamb }))
+        Ok(Some(TreeFile {
+            rank,
+            trees,
+            lamb,
+            max_hemi,
+            totals,
+        }))
     }
 
     /// The Lambertian parts split off XML `Reflection Back`, `Reflection Front`,
     /// `Transmission Back`, `Transmission Front` (a missing transmission shows the other's).
     pub fn lambertians(&self) -> [Lambertian; 4] {
         self.lamb
+    }
+
+    /// Radiance's largest directional-hemispherical total of XML `Reflection Back`,
+    /// `Reflection Front`, `Transmission Back`, `Transmission Front` (Lambertian part included):
+    /// π × the largest mean of the tree over incident strips of the smallest leaf's width, at
+    /// least 1/32 (rank 3: strips of the reachable half; rank 4: squares).
+    pub fn max_totals(&self) -> [Option<f64>; 4] {
+        self.max_hemi
+    }
+
+    /// The component table of XML `Reflection Back`, `Reflection Front`, `Transmission Back`,
+    /// `Transmission Front` (index 0…3; `None` without that tree): Radiance's Lambertian part,
+    /// largest directional total and angle, plus fenestra's totals for normal and diffuse
+    /// incidence (integrated leaf by leaf: exact for the nearest-leaf tree; `totals` is left
+    /// empty).
+    pub fn component(&self, k: usize) -> Option<crate::check::ComponentCheck> {
+        let (normal_total, diffuse_total, leaf) = self.totals[k]?;
+        let l = self.lamb[k];
+        Some(crate::check::ComponentCheck {
+            lambertian_xyz: l.xyz,
+            lambertian_y: l.y / PI,
+            max_total: self.max_hemi[k]?,
+            min_angle_deg: ((PI * leaf * leaf) / PI).sqrt() * (360.0 / PI),
+            normal_total,
+            diffuse_total,
+            totals: Vec::new(),
+        })
     }
 
     /// Whether a component has colour trees (CIE-u/v).
@@ -1192,5 +1302,51 @@ mod tests {
         assert_eq!(t.smallest_leaf(), 0.25);
         assert!(parse_tree(3, "{ 1 2 3 }").is_err());
         assert!(parse_tree(3, "{ 1 } x").is_err());
+    }
+}
+
+#[cfg(test)]
+mod table_tests {
+    use super::*;
+
+    /// The leaf-by-leaf totals equal the finest-grid integration of [`crate::check::tree_component`]
+    /// (to rounding) on genBSDF's rank-3 and rank-4 blinds.
+    #[test]
+    fn leafwise_totals_match_grid_integration() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../tests/fixtures/dctimestep");
+        for f in ["blinds_t3.xml", "blinds_t4.xml"] {
+            let p = dir.join(f);
+            let xml = std::fs::read_to_string(&p).unwrap();
+            let b = crate::read::parse(&xml, f).unwrap();
+            let t = TreeFile::load(&xml).unwrap().unwrap();
+            let dirs = [
+                Direction::ReflectionBack,
+                Direction::ReflectionFront,
+                Direction::TransmissionBack,
+                Direction::TransmissionFront,
+            ];
+            for (k, d) in dirs.into_iter().enumerate() {
+                let (Some(grid), Some(leaf)) =
+                    (crate::check::tree_component(&b, d), t.component(k))
+                else {
+                    assert!(t.component(k).is_none(), "{f} {d:?}");
+                    continue;
+                };
+                for (a, g) in [
+                    (leaf.normal_total, grid.normal_total),
+                    (leaf.diffuse_total, grid.diffuse_total),
+                    (leaf.min_angle_deg, grid.min_angle_deg),
+                ] {
+                    assert!(
+                        (a - g).abs() < 1e-9 * g.abs().max(1.0),
+                        "{f} {d:?}: {a} vs {g}"
+                    );
+                }
+                // Radiance's strip means and the finest-grid totals agree on these trees
+                // (strips of the finest cell).
+                assert!((leaf.max_total - grid.max_total).abs() < 1e-6, "{f} {d:?}");
+            }
+        }
     }
 }
