@@ -491,6 +491,75 @@ fn tree_file_wl(dir: &Path, name: &str, blocks: &[(&str, &str, &str, String)]) -
     p
 }
 
+/// A tree refined along one child down to `depth` levels (then a full grid of values), the
+/// other children single values: leaves down to 1/2^(depth+1).
+fn chain_tree(next: &mut dyn FnMut() -> f64, rank: usize, depth: u32, child: usize) -> String {
+    if depth == 0 {
+        let vals: Vec<String> = (0..1 << rank)
+            .map(|_| format!("{:.5}", 0.2 + next()))
+            .collect();
+        return format!("{{ {} }}", vals.join(" "));
+    }
+    let kids: Vec<String> = (0..1 << rank)
+        .map(|n| {
+            if n == child {
+                chain_tree(next, rank, depth - 1, child)
+            } else {
+                format!("{{ {:.5} }}", 0.1 + next())
+            }
+        })
+        .collect();
+    format!("{{ {} }}", kids.join(" "))
+}
+
+/// Trees with leaves finer than 1/32 (down to 1/128; angles 1.79 and 0.90 deg): the sampling's
+/// cells split below 1/32 (down to Radiance's `π·cell² − 1e-6` limit) and the table's totals come
+/// from strips of the smallest leaf; whole sections equal to the oracle's in one run.
+#[test]
+fn oracle_deep_trees() {
+    let Some(o) = common::oracle() else { return };
+    let dir = common::scratch("checkbsdf-deep-trees");
+    let mut seed = 0x2545_f491_4f6c_dd1du64;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut files = Vec::new();
+    for (k, (rank, child, depth)) in [(3, 0, 5), (3, 6, 5), (3, 2, 6), (4, 0, 4), (4, 5, 5)]
+        .into_iter()
+        .enumerate()
+    {
+        let blocks = vec![
+            (
+                "Reflection Back",
+                "BRDF",
+                chain_tree(&mut next, rank, depth, child),
+            ),
+            (
+                "Transmission Front",
+                "BTDF",
+                chain_tree(&mut next, rank, depth - 1, child),
+            ),
+            (
+                "Transmission Back",
+                "BTDF",
+                chain_tree(&mut next, rank, depth, child),
+            ),
+        ];
+        let name = format!("deep{k}.xml");
+        let p = tree_file(&dir, &name, &blocks);
+        if rank == 3 {
+            let t = std::fs::read_to_string(&p).unwrap();
+            std::fs::write(&p, t.replace("TensorTree4", "TensorTree3")).unwrap();
+        }
+        files.push(PathBuf::from(name));
+    }
+    let refs: Vec<&Path> = files.iter().map(PathBuf::as_path).collect();
+    same_as_oracle(&o, &dir, &refs);
+}
+
 /// Synthetic rank-4 trees run through the oracle; Radiance's whole section compared line by line.
 /// Reciprocal trees (`v(a, b, c, d) = v(n−1−c, n−1−d, n−1−a, n−1−b)`: the reverse of incident
 /// cell (a, b) and outgoing (c, d) in Radiance's tree coordinates) give Radiance's
