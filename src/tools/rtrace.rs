@@ -7,9 +7,17 @@ use anyhow::{bail, Context, Result};
 use fenestra_trace::{DVec3, TraceOptions, Tracer};
 use rayon::prelude::*;
 
-/// Input records per block of source-thresholding statistics (`-dt > 0`): a block is
-/// traced in order by one thread, so the output does not depend on `-n`.
-const BLOCK: usize = 64;
+/// Source thresholding (`-dt > 0`) carries shadow-test statistics over the whole run, as
+/// Radiance does, deterministically for any `-n`: records are traced in blocks (one thread
+/// traces a block's records in order) and blocks in waves of 1, 1, 2, 4, 8, then
+/// `WAVE_MAX` blocks; every block of a wave starts from the statistics of all earlier
+/// waves, merged in record order. A block is `BLOCK_AB0` records with `-ab 0` (cheap
+/// records: the first 32 follow each other exactly), one record with `-ab > 0` (each record
+/// traces many rays: they spread over the threads).
+const BLOCK_AB0: usize = 16;
+const WAVE_MAX: usize = 16;
+/// Records per parallel batch without thresholding.
+const CHUNK: usize = 1024;
 
 const USAGE: &str = "[-I|-i][-o{o,d,v,w,l,L,p,n,N}][-f{a,f,d}{a,f,d}][-h][-x N][-y N][-n N][-ab N][-ad N][-aa V][-ar N][-as N][-av r g b][-lw W][-lr N][-ds V][-dj V][-dc V][-dr N][-dt V][-st V][-ss V][-bv][-u][-v][-full][-seed N] scene.{rad,oct}…";
 
@@ -159,14 +167,19 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     }
     // With source thresholding the shadow-test statistics are carried from record to
     // record within a block of BLOCK consecutive records, traced in order by one thread.
-    let block = if tracer.thresholding() { BLOCK } else { 1 };
+    let thresholding = tracer.thresholding();
+    let block = if thresholding && o.ab == 0 {
+        BLOCK_AB0
+    } else {
+        1
+    };
     if verbose {
         for n in &tracer.effects().notes {
             eprintln!("{}: {n}", fenestra_cli::prog());
         }
-        if block > 1 {
+        if thresholding {
             eprintln!(
-                "{}: source thresholding: hit statistics and obstructor caches start afresh every {block} input records",
+                "{}: source thresholding: hit statistics and obstructor caches carried over the run, in blocks of {block} record(s) traced in waves of 1, 1, 2, 4, 8, then {WAVE_MAX} blocks (each block starts from all earlier waves)",
                 fenestra_cli::prog()
             );
         }
@@ -200,9 +213,17 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(nproc).build()?;
     let progress = fenestra_cli::progress::Progress::new(n as u64, "rtrace");
-    let chunk = 1024;
-    for start in (0..n).step_by(chunk) {
-        let end = (start + chunk).min(n);
+    let mut base = tracer.direct_state();
+    let (mut start, mut wave) = (0usize, 0usize);
+    while start < n {
+        let width = if !thresholding {
+            CHUNK
+        } else if wave == 0 {
+            1
+        } else {
+            (1usize << (wave - 1).min(16)).min(WAVE_MAX)
+        };
+        let end = (start + width * block).min(n);
         let record = |k: usize, st: &mut fenestra_trace::DirectState| {
             let (org, dir) = rays[k];
             let mut rec = Vec::new();
@@ -235,20 +256,27 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             }
             rec
         };
-        let vals: Vec<Vec<f64>> = pool.install(|| {
-            let blocks: Vec<Vec<Vec<f64>>> = (start..end)
+        let blocks: Vec<(Vec<Vec<f64>>, fenestra_trace::DirectState)> = pool.install(|| {
+            (start..end)
                 .step_by(block)
                 .collect::<Vec<_>>()
                 .into_par_iter()
                 .map(|b| {
-                    let mut st = tracer.direct_state();
-                    (b..(b + block).min(end))
+                    let mut st = base.fork();
+                    let recs = (b..(b + block).min(end))
                         .map(|k| record(k, &mut st))
-                        .collect()
+                        .collect();
+                    (recs, st)
                 })
-                .collect();
-            blocks.into_iter().flatten().collect()
+                .collect()
         });
+        let mut vals = Vec::with_capacity(end - start);
+        for (recs, st) in blocks {
+            vals.extend(recs);
+            if thresholding {
+                base.merge(st);
+            }
+        }
         for rec in vals {
             match fout {
                 Fmt::Ascii => {
@@ -272,6 +300,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             }
         }
         progress.inc((end - start) as u64);
+        start = end;
+        wave += 1;
     }
     progress.finish();
     w.flush()?;

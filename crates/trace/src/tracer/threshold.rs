@@ -20,6 +20,7 @@
 
 use super::*;
 use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::Arc;
 
 /// Shadow tests always made before the threshold applies (Radiance's MINSHADCNT).
 pub(super) const MIN_TESTS: usize = 2;
@@ -64,12 +65,27 @@ pub(super) struct Candidate {
 
 /// Hit statistics and obstructor caches of source thresholding, carried from one input
 /// ray to the next (see the module documentation).
+///
+/// A state can be [`fork`](Self::fork)ed into states that go on from it independently
+/// (one per block of records, traced in parallel), whose changes are then
+/// [`merge`](Self::merge)d back in a fixed order: the counts added, the cache cells each
+/// set in turn. That keeps a whole run's statistics, as Radiance does, while the result
+/// does not depend on which thread traced which block.
 #[derive(Debug, Clone, Default)]
 pub struct DirectState {
     ntests: Vec<u64>,
     nhits: Vec<u64>,
-    /// Per source: its cache once changed (else the tracer's initial one).
+    /// Counts when forked (merging adds the difference).
+    ntests0: Vec<u64>,
+    nhits0: Vec<u64>,
+    /// Per source: cells changed before the fork ([`UNCAST`]: the initial cell).
+    shared: Arc<Vec<Option<Vec<u32>>>>,
+    /// Per source: cells changed since the fork (copied from `shared` on first change).
     cache: Vec<Option<Vec<u32>>>,
+    /// The changes since the fork, in order: (source, cell, value); not kept by a state
+    /// that was not forked (nothing merges it).
+    log: Vec<(usize, usize, u32)>,
+    forked: bool,
     cands: Vec<Candidate>,
     tail: Vec<f32>,
 }
@@ -77,6 +93,84 @@ pub struct DirectState {
 impl DirectState {
     fn rate(&self, si: usize) -> f64 {
         self.nhits[si] as f64 / self.ntests[si] as f64
+    }
+
+    /// Cell `k` of source `si`'s cache as this state has it ([`UNCAST`]: initial).
+    fn cell(&self, si: usize, k: usize) -> u32 {
+        [&self.cache[si], &self.shared[si]]
+            .into_iter()
+            .flatten()
+            .map(|c| c[k])
+            .find(|&v| v != UNCAST)
+            .unwrap_or(UNCAST)
+    }
+
+    fn set_cell(&mut self, si: usize, k: usize, v: u32, len: usize) {
+        let shared = &self.shared;
+        self.cache[si]
+            .get_or_insert_with(|| shared[si].clone().unwrap_or_else(|| vec![UNCAST; len]))[k] = v;
+        if self.forked {
+            self.log.push((si, k, v));
+        }
+    }
+
+    /// A state that goes on from this one (its statistics and caches as they are now).
+    pub fn fork(&self) -> DirectState {
+        self.fork_keeping(self.ntests.clone(), self.nhits.clone())
+    }
+
+    fn fork_keeping(&self, ntests: Vec<u64>, nhits: Vec<u64>) -> DirectState {
+        let mut shared = self.shared.clone();
+        if self.cache.iter().any(Option::is_some) {
+            let s = Arc::make_mut(&mut shared);
+            for (si, c) in self.cache.iter().enumerate() {
+                if let Some(c) = c {
+                    s[si] = Some(c.clone());
+                }
+            }
+        }
+        DirectState {
+            ntests0: ntests.clone(),
+            nhits0: nhits.clone(),
+            ntests,
+            nhits,
+            shared,
+            cache: vec![None; self.cache.len()],
+            log: Vec::new(),
+            forked: true,
+            cands: Vec::new(),
+            tail: Vec::new(),
+        }
+    }
+
+    /// Adds what `child` (forked from this state) learnt: its test and hit counts, then
+    /// its cache changes in the order it made them. Merging the children of one fork in
+    /// a fixed order gives the same state whatever order they were traced in.
+    pub fn merge(&mut self, child: DirectState) {
+        for si in 0..self.ntests.len() {
+            self.ntests[si] += child.ntests[si] - child.ntests0[si];
+            self.nhits[si] += child.nhits[si] - child.nhits0[si];
+        }
+        if child.log.is_empty() {
+            return;
+        }
+        if self.cache.iter().any(Option::is_some) {
+            // this state's own changes go first (it was traced with, then merged into)
+            let mut own = self.fork_keeping(self.ntests.clone(), self.nhits.clone());
+            own.ntests0 = std::mem::take(&mut self.ntests0);
+            own.nhits0 = std::mem::take(&mut self.nhits0);
+            own.log = std::mem::take(&mut self.log);
+            own.forked = self.forked;
+            *self = own;
+        }
+        let shared = Arc::make_mut(&mut self.shared);
+        for &(si, k, v) in &child.log {
+            let len = child.cache[si].as_ref().map_or(0, Vec::len);
+            shared[si].get_or_insert_with(|| vec![UNCAST; len])[k] = v;
+        }
+        if self.forked {
+            self.log.extend(child.log);
+        }
     }
 }
 
@@ -255,7 +349,12 @@ impl Tracer {
         DirectState {
             ntests: vec![2; n],
             nhits: vec![1; n],
+            ntests0: vec![2; n],
+            nhits0: vec![1; n],
+            shared: Arc::new(vec![None; n]),
             cache: vec![None; n],
+            log: Vec::new(),
+            forked: false,
             cands: Vec::new(),
             tail: Vec::new(),
         }
@@ -394,9 +493,9 @@ impl Tracer {
         let Some(k) = oc.geom.cell(p, l) else {
             return false;
         };
-        let b = match st.cache[si].as_deref().map(|c| c[k]) {
-            Some(v) if v != UNCAST => v,
-            _ => self.initial_cell(oc, k),
+        let b = match st.cell(si, k) {
+            UNCAST => self.initial_cell(oc, k),
+            v => v,
         };
         if b == 0 || Some(b as usize - 1) == skip || self.own_emitter(si, b as usize - 1) {
             return false;
@@ -439,9 +538,7 @@ impl Tracer {
             return;
         };
         if self.blocker[h.shape] && !self.own_emitter(si, h.shape) {
-            st.cache[si].get_or_insert_with(|| {
-                oc.cells.iter().map(|c| c.load(Ordering::Relaxed)).collect()
-            })[k] = h.shape as u32 + 1;
+            st.set_cell(si, k, h.shape as u32 + 1, oc.cells.len());
         }
     }
 
