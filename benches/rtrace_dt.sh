@@ -5,10 +5,11 @@
 #   A: -I+ -ab 0 over 30000 points (the fixture's 30 points shifted 1000 times by 1.3 mm)
 #   B: -I+ -ab 1 -ad 1024 -aa 0 over 120 points (the fixture's 30 points shifted 4 times by 1.3 cm)
 # Prints hyperfine's table and the mean user (CPU) time of each command: the machine is shared.
-# Usage: benches/rtrace_dt.sh [runs]   (needs .oracle/env and a testopt build of rtrace)
+# Usage: benches/rtrace_dt.sh [runs] [threads (-n, default 1)]   (needs .oracle/env and a testopt build of rtrace)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 runs=${1:-3}
+threads=${2:-1}
 set -a; . .oracle/env 2>/dev/null || . /work/main/.oracle/env; set +a
 export FENESTRA_NO_PROGRESS=1
 ours=$(realpath "${CARGO_TARGET_DIR:-target}/testopt/rtrace")
@@ -19,7 +20,7 @@ awk '{for (k = 0; k < 1000; k++) print $1 + 0.0013 * k, $2, $3, $4, $5, $6}' poi
 awk '{for (k = 0; k < 4; k++) print $1 + 0.013 * k, $2, $3, $4, $5, $6}' points.txt > some.txt
 RAYPATH=.:$FENESTRA_ORACLE_LIB "$FENESTRA_ORACLE_BIN/oconv" scene.rad > s.oct
 ref="RAYPATH=.:$FENESTRA_ORACLE_LIB $FENESTRA_ORACLE_BIN/rtrace"
-for case in "A|-h -I+ -ab 0 -n 1|many.txt" "B|-h -I+ -ab 1 -ad 1024 -aa 0 -n 1|some.txt"; do
+for case in "A|-h -I+ -ab 0 -n $threads|many.txt" "B|-h -I+ -ab 1 -ad 1024 -aa 0 -n $threads|some.txt"; do
   IFS='|' read -r name opts input <<< "$case"
   echo "== $name: $opts < $input ($(wc -l < "$input") records); load: $(uptime | sed 's/.*load/load/')"
   hyperfine -w 1 -r "$runs" --export-markdown "times_$name.md" --export-json "times_$name.json" \
