@@ -14,8 +14,9 @@
 //!
 //! Radiance keeps the hit counts and its obstructor caches for the whole run, so its
 //! results depend on the order of the input rays and on its processes. fenestra keeps
-//! them in a [`DirectState`] that rtrace starts afresh for every block of consecutive
-//! input records and that one thread uses in input order: the output is the same for
+//! them in a [`DirectState`] the caller carries from ray to ray; rtrace forks it for
+//! blocks of records traced in parallel and merges the blocks' changes back in record
+//! order ([`DirectState::fork`], [`DirectState::merge`]), so its output is the same for
 //! any number of threads.
 
 use super::*;
