@@ -1745,7 +1745,19 @@ mod tests {
     fn select_of_folded_constants_is_a_table() {
         let src = "k : 3; f(r) = if(r - 1, 2*r + k, -0);\n\
                    $1 = select($1, f(0), f(1), f(2), 360/f(3)); $2 = select($2 + 1, f(1), $1, 4);";
-        let special = [f64::NAN, -1.0, 0.0, 0.4, 1.0, 2.0, 3.0, 3.6, 4.0, 5.0, 1e300];
+        let special = [
+            f64::NAN,
+            -1.0,
+            0.0,
+            0.4,
+            1.0,
+            2.0,
+            3.0,
+            3.6,
+            4.0,
+            5.0,
+            1e300,
+        ];
         let (fast, hits) = agree_on_pairs(src, &special);
         let ops: Vec<Op> = fast
             .fast
@@ -1754,8 +1766,14 @@ mod tests {
             .flatten()
             .flat_map(|f| f.ops.clone())
             .collect();
-        let tables = ops.iter().filter(|o| matches!(o, Op::SelectK { .. })).count();
-        let jumps = ops.iter().filter(|o| matches!(o, Op::Select { .. })).count();
+        let tables = ops
+            .iter()
+            .filter(|o| matches!(o, Op::SelectK { .. }))
+            .count();
+        let jumps = ops
+            .iter()
+            .filter(|o| matches!(o, Op::Select { .. }))
+            .count();
         // $1 is a table; $2 has a case that is not a constant (a jump table)
         assert_eq!((tables, jumps), (1, 1), "{ops:?}");
         assert!(hits > 0);
