@@ -730,6 +730,11 @@ fn oracle_rcalc_runs_our_bin_files() {
         let (fok, fout, ferr) = run_with(ours(&args), input.as_bytes());
         assert!(fok, "{ferr}");
         assert_eq!(oout.lines().count(), 7 * rows.len(), "{file} {pre}");
+        assert_eq!(
+            fout.lines().count(),
+            7 * rows.len(),
+            "{file} {pre}: fenestra"
+        );
         for (i, (a, b)) in oout.lines().zip(fout.lines()).enumerate() {
             assert_eq!(a, b, "{file} {pre}: input line {i}");
         }

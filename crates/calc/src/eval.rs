@@ -312,6 +312,15 @@ impl Compiled {
         self.vars.iter().any(|s| matches!(s, VarSlot::Def(_, true)))
     }
 
+    /// Whether expression `e` has fast code (built now if not yet); false when the
+    /// compiler gave up on it or fast code is switched off (`FENESTRA_CALC_EXACT`).
+    pub fn has_fast_code(&self, e: ExprId) -> bool {
+        let id = self.vars.len() + self.chans.len() + e.0 as usize;
+        self.fast
+            .get(id)
+            .is_some_and(|f| f.get_or_init(|| self.build_fast(id)).is_some())
+    }
+
     /// Makes room for the fast code of every root (built at first use).
     pub(crate) fn enable_fast(&mut self) {
         let n = self.vars.len() + self.chans.len() + self.exprs.len();

@@ -468,6 +468,34 @@ impl<'a> Fc<'a> {
         }
     }
 
+    /// Removes the `Add` (`mul` false) or `Mul` op just written to the newest temporary
+    /// `r` when `keep` names the operand it equals (`x + 0`, `x * 1`), and returns that
+    /// operand; otherwise returns `r` unchanged.
+    fn elide_identity(
+        &mut self,
+        r: u32,
+        mul: bool,
+        keep: impl Fn(&Self, u32, u32) -> Option<u32>,
+    ) -> u32 {
+        let (d, a, b) = match (self.ops.last().copied(), mul) {
+            (Some(Op::Add { d, a, b }), false) | (Some(Op::Mul { d, a, b }), true) => (d, a, b),
+            _ => return r,
+        };
+        if d != r || r + 1 != self.ntemp {
+            return r;
+        }
+        let Some(k) = keep(self, a, b) else {
+            return r;
+        };
+        self.ops.pop();
+        self.rollback_cse_of(d);
+        self.ntemp -= 1;
+        if let Some(f) = self.no_neg_zero.get_mut(d as usize) {
+            *f = false;
+        }
+        k
+    }
+
     /// Forgets the common-subexpression entry of the op just removed.
     fn rollback_cse_of(&mut self, d: u32) {
         if let Some(Undo::Cse(k)) = self.undo.last() {
@@ -831,28 +859,17 @@ impl<'a> Fc<'a> {
                     |d, a, b| Op::Add { d, a, b },
                 )?;
                 // x + ±0 is x when x is itself a sum or a floor (never -0)
-                if let Some(Op::Add { d, a, b }) = self.ops.last().copied() {
-                    if d == r && r + 1 == self.ntemp {
-                        let zero = |q: u32| self.kval(q) == Some(0.0);
-                        let nz =
-                            |q: u32| !is_k(q) && self.no_neg_zero.get(q as usize) == Some(&true);
-                        let keep = if zero(b) && nz(a) {
-                            Some(a)
-                        } else if zero(a) && nz(b) {
-                            Some(b)
-                        } else {
-                            None
-                        };
-                        if let Some(k) = keep {
-                            self.ops.pop();
-                            self.rollback_cse_of(d);
-                            self.ntemp -= 1;
-                            self.no_neg_zero[d as usize] = false;
-                            return Ok(k);
-                        }
+                Ok(self.elide_identity(r, false, |s, a, b| {
+                    let zero = |q: u32| s.kval(q) == Some(0.0);
+                    let nz = |q: u32| !is_k(q) && s.no_neg_zero.get(q as usize) == Some(&true);
+                    if zero(b) && nz(a) {
+                        Some(a)
+                    } else if zero(a) && nz(b) {
+                        Some(b)
+                    } else {
+                        None
                     }
-                }
-                Ok(r)
+                }))
             }
             Node::Sub(p) => self.binary(
                 &p.0,
@@ -870,25 +887,16 @@ impl<'a> Fc<'a> {
                     |d, a, b| Op::Mul { d, a, b },
                 )?;
                 // x*1 is x (also for infinities, NaNs and signed zeros)
-                if let Some(Op::Mul { d, a, b }) = self.ops.last().copied() {
-                    if d == r && r + 1 == self.ntemp {
-                        let one = |q: u32| self.kval(q) == Some(1.0);
-                        let keep = if one(b) {
-                            Some(a)
-                        } else if one(a) {
-                            Some(b)
-                        } else {
-                            None
-                        };
-                        if let Some(k) = keep {
-                            self.ops.pop();
-                            self.rollback_cse_of(d);
-                            self.ntemp -= 1;
-                            return Ok(k);
-                        }
+                Ok(self.elide_identity(r, true, |s, a, b| {
+                    let one = |q: u32| s.kval(q) == Some(1.0);
+                    if one(b) {
+                        Some(a)
+                    } else if one(a) {
+                        Some(b)
+                    } else {
+                        None
                     }
-                }
-                Ok(r)
+                }))
             }
             Node::Div(p) => self.binary(
                 &p.0,

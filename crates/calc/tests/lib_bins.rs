@@ -41,13 +41,22 @@ fn bins(pre: &str, file: &Path, expr: &str, ds: &[[f64; 3]], exact: bool) -> Vec
     let c = p.compile().unwrap();
     std::env::remove_var("FENESTRA_CALC_EXACT");
     let mut st = c.state();
-    ds.iter()
+    let out = ds
+        .iter()
         .map(|d| {
             st.set_all(&vars, d);
             c.eval_expr(&mut st, id)
                 .unwrap_or_else(|e| panic!("{expr} at {d:?}: {e}"))
         })
-        .collect()
+        .collect();
+    // the "fast" pass must really run fast code (no quiet fall-back to the exact one)
+    assert_eq!(
+        c.has_fast_code(id),
+        !exact,
+        "{expr} ({}): fast code",
+        file.display()
+    );
+    out
 }
 
 fn next_up(x: f64, k: i64) -> f64 {
