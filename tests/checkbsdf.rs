@@ -643,3 +643,77 @@ fn oracle_tree_check_sections() {
         }
     }
 }
+
+/// A CIE-v tree leaf without a chromaticity (v′ = 0: CIE y = 0; v′ ≥ 0.75 + 0.375u′: divisor
+/// 6u′ − 16v′ + 12 ≤ 0) is an error naming the file, line and block. Radiance 6.0a loads such
+/// files and prints `-nan` (v′ = 0) or negative percentages (v′ = 0.9) as Lambertian XYZ; with
+/// the oracle installed, its `nan` is checked here too, as the reason for the error.
+#[test]
+fn colour_tree_without_chromaticity_is_an_error() {
+    let dir = common::scratch("checkbsdf-bad-chroma");
+    let grid = |v: &dyn Fn(usize) -> f64| {
+        let vals: Vec<String> = (0..16).map(|k| format!("{}", v(k))).collect();
+        format!("{{ {} }}", vals.join(" "))
+    };
+    let d = "Transmission Front";
+    for (name, bad) in [("v0.xml", 0.0), ("vbig.xml", 0.9)] {
+        let p = tree_file_wl(
+            &dir,
+            name,
+            &[
+                ("Visible", d, "BTDF", grid(&|k| 0.3 + 0.05 * k as f64)),
+                ("CIE-u", d, "BTDF", grid(&|_| 0.2)),
+                (
+                    "CIE-v",
+                    d,
+                    "BTDF",
+                    grid(&|k| if k == 15 { bad } else { 0.47 }),
+                ),
+            ],
+        );
+        let out = ours(&dir, Path::new(name));
+        assert!(!out.status.success(), "{name}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains(name)
+                && err.contains(", line ")
+                && err.contains("CIE-v Transmission Front"),
+            "{err}"
+        );
+        assert!(
+            err.contains(&format!("value {bad} outside (0, 0.75)")),
+            "{err}"
+        );
+        if let (Some(o), 0.0) = (common::oracle(), bad) {
+            let theirs = common::run_ok(o.command("checkBSDF").current_dir(&dir).arg(name));
+            assert!(String::from_utf8_lossy(&theirs).contains("nan"), "{p:?}");
+        }
+    }
+}
+
+/// A tree with leaves smaller than 1/65536 (a rank-3 chain 17 levels deep) is an error naming
+/// the file and line, not a run of 2^17 radii; deep brace nesting is an error too, not a stack
+/// overflow.
+#[test]
+fn too_deep_trees_are_errors() {
+    let dir = common::scratch("checkbsdf-too-deep");
+    fn chain(levels: u32) -> String {
+        if levels == 0 {
+            return "{ 0.5 }".into();
+        }
+        format!("{{\n{} {} }}", chain(levels - 1), ["{ 0.2 }"; 7].join(" "))
+    }
+    for (name, tree, want) in [
+        ("chain17.xml", chain(17), "deeper than 16 levels"),
+        ("nest.xml", "{".repeat(200_000), "deeper than 16 levels"),
+    ] {
+        let p = tree_file(&dir, name, &[("Reflection Back", "BRDF", tree)]);
+        let t = std::fs::read_to_string(&p).unwrap();
+        std::fs::write(&p, t.replace("TensorTree4", "TensorTree3")).unwrap();
+        let out = ours(&dir, Path::new(name));
+        assert!(!out.status.success(), "{name}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(name) && err.contains(", line "), "{err}");
+        assert!(err.contains(want), "{err}");
+    }
+}

@@ -227,6 +227,11 @@ fn report(
                 SampledRow::Values(r) => rec(&mut s, label, Some(r)),
                 SampledRow::Absent => rec(&mut s, label, None),
                 SampledRow::Dropped => {}
+                SampledRow::NoColour => bail!(
+                    "{name}: {label} reciprocity: a sampled pair met a colour-tree leaf whose \
+                     mean CIE (u', v') has no chromaticity (v' = 0: the CIE-u and CIE-v trees \
+                     are much coarser than the other tree there)"
+                ),
             }
         }
     } else {

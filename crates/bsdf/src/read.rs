@@ -7,7 +7,7 @@ use crate::klems::KlemsBasis;
 use crate::model::{
     Block, BlockData, Bsdf, DataStructure, Direction, Geometry, KlemsMatrix, Wavelength,
 };
-use crate::tree::TensorTree;
+use crate::tree::{TensorTree, ValueCheck};
 
 /// An error reading a BSDF XML file, with the 1-based line where it was found.
 #[derive(Debug, thiserror::Error)]
@@ -131,10 +131,20 @@ pub fn parse(text: &str, file: &str) -> Result<Bsdf, XmlError> {
                     } else {
                         4
                     };
-                    let t = TensorTree::parse(rank, &sd.text).map_err(|e| {
+                    let check: ValueCheck = if wavelength == Wavelength::CieV {
+                        &chroma_v
+                    } else {
+                        &|_| Ok(())
+                    };
+                    let t = TensorTree::parse_checked(rank, &sd.text, check).map_err(|e| {
                         err(
                             sd.text_pos + e.offset,
-                            format!("ScatteringData: {}", e.message),
+                            format!(
+                                "ScatteringData ({} {}): {}",
+                                wavelength.xml_name(),
+                                direction.xml_name(),
+                                e.message
+                            ),
                         )
                     })?;
                     BlockData::Tree(t)
@@ -184,6 +194,20 @@ pub fn parse(text: &str, file: &str) -> Result<Bsdf, XmlError> {
         }
     }
     Ok(bsdf)
+}
+
+/// A CIE v′ value of a colour tree must give a chromaticity: v′ = 0 divides by zero when it is
+/// turned into CIE (x, y), and v′ ≥ 0.75 + 0.375·u′ makes the divisor 6u′ − 16v′ + 12 zero or
+/// negative (u′ ≥ 0, so v′ < 0.75 keeps it positive for every u′; colours of real light have
+/// v′ below 0.6). Radiance 6.0a prints NaN or negative Lambertian XYZ for such files.
+fn chroma_v(v: f64) -> Result<(), String> {
+    if v > 0.0 && v < 0.75 {
+        Ok(())
+    } else {
+        Err(format!(
+            "CIE v' value {v} outside (0, 0.75): no chromaticity (expected v' of a colour, below 0.6)"
+        ))
+    }
 }
 
 fn leading_comments(text: &str) -> Vec<String> {

@@ -19,6 +19,15 @@ enum Node {
     Grid { log2: u32, values: Vec<f32> },
 }
 
+/// Finest leaf edge accepted in a tree: leaves smaller than 1/2^16 per dimension (branch levels
+/// plus a grid's levels) are rejected. The reciprocity sampling walks one radius per smallest
+/// leaf and the slice sizes are rounded to 1/65536, so deeper trees would only cost time (and,
+/// below 2^-53, never end); the limit also bounds the parser's recursion.
+pub const MAX_TREE_LEVELS: u32 = 16;
+
+/// A check on every value of a tree (`Err` with what is wrong).
+pub type ValueCheck<'a> = &'a dyn Fn(f64) -> Result<(), String>;
+
 /// A tree parse error: message and byte offset inside the parsed text.
 #[derive(Debug, PartialEq)]
 pub struct TreeError {
@@ -31,13 +40,20 @@ pub struct TreeError {
 impl TensorTree {
     /// Parses `ScatteringData` text of a tree of the given rank (3 or 4).
     pub fn parse(rank: usize, text: &str) -> Result<Self, TreeError> {
+        Self::parse_checked(rank, text, &|_| Ok(()))
+    }
+
+    /// [`TensorTree::parse`] with every value passed through `check` (an error names the value's
+    /// offset).
+    pub fn parse_checked(rank: usize, text: &str, check: ValueCheck) -> Result<Self, TreeError> {
         let mut p = Parser {
             s: text.as_bytes(),
             i: 0,
             rank,
+            check,
         };
         p.skip();
-        let root = p.node()?;
+        let root = p.node(0)?;
         p.skip();
         if p.i < p.s.len() {
             return Err(p.err("extra characters after the tree's root node"));
@@ -177,6 +193,7 @@ struct Parser<'a> {
     s: &'a [u8],
     i: usize,
     rank: usize,
+    check: ValueCheck<'a>,
 }
 
 impl Parser<'_> {
@@ -195,17 +212,29 @@ impl Parser<'_> {
         }
     }
 
-    fn node(&mut self) -> Result<Node, TreeError> {
+    /// One node `levels` branch levels below the root.
+    fn node(&mut self, levels: u32) -> Result<Node, TreeError> {
         if self.s.get(self.i) != Some(&b'{') {
             return Err(self.err("expected '{'"));
         }
+        let open = self.i;
         self.i += 1;
         self.skip();
         if self.s.get(self.i) == Some(&b'{') {
+            if levels >= MAX_TREE_LEVELS {
+                return Err(TreeError {
+                    message: format!(
+                        "tree nested deeper than {MAX_TREE_LEVELS} levels (leaves smaller than \
+                         1/{} are not supported)",
+                        1u64 << MAX_TREE_LEVELS
+                    ),
+                    offset: open,
+                });
+            }
             let n = 1 << self.rank;
             let mut ch = Vec::with_capacity(n);
             for _ in 0..n {
-                ch.push(self.node()?);
+                ch.push(self.node(levels + 1)?);
                 self.skip();
             }
             if self.s.get(self.i) != Some(&b'}') {
@@ -249,6 +278,10 @@ impl Parser<'_> {
                     offset: start,
                 });
             }
+            (self.check)(v).map_err(|m| TreeError {
+                message: m,
+                offset: start,
+            })?;
             values.push(v as f32);
         }
         let mut log2 = 0u32;
@@ -263,6 +296,17 @@ impl Parser<'_> {
                 values.len(),
                 self.rank
             )));
+        }
+        if levels + log2 > MAX_TREE_LEVELS {
+            return Err(TreeError {
+                message: format!(
+                    "tree leaves smaller than 1/{} ({levels} branch levels and a grid of {} \
+                     per dimension)",
+                    1u64 << MAX_TREE_LEVELS,
+                    1u64 << log2
+                ),
+                offset: open,
+            });
         }
         Ok(Node::Grid { log2, values })
     }
@@ -286,6 +330,43 @@ mod tests {
         assert!(TensorTree::parse(3, "{1} x").is_err());
         assert!(TensorTree::parse(3, "{-1}").is_err());
         assert!(TensorTree::parse(4, "{ {1} }").is_err());
+    }
+
+    /// Leaves down to 1/2^16 per dimension parse; one level more, or brace nesting far deeper
+    /// (no stack overflow), is an error at the offending node.
+    #[test]
+    fn depth_limit() {
+        fn chain(levels: u32, grid: &str) -> String {
+            if levels == 0 {
+                return grid.to_string();
+            }
+            format!("{{ {} {} }}", chain(levels - 1, grid), ["{1}"; 7].join(" "))
+        }
+        let g2 = format!("{{ {} }}", ["1"; 8].join(" "));
+        assert!(TensorTree::parse(3, &chain(15, &g2)).is_ok());
+        assert!(TensorTree::parse(3, &chain(16, "{1}")).is_ok());
+        let e = TensorTree::parse(3, &chain(16, &g2)).unwrap_err();
+        assert!(e.message.contains("smaller than 1/65536"), "{}", e.message);
+        let e = TensorTree::parse(3, &chain(17, "{1}")).unwrap_err();
+        assert!(e.message.contains("deeper than 16"), "{}", e.message);
+        assert_eq!(e.offset, 2 * 16);
+        let deep = "{ ".repeat(1_000_000);
+        let e = TensorTree::parse(4, &deep).unwrap_err();
+        assert_eq!(e.offset, 2 * 16);
+    }
+
+    #[test]
+    fn value_check() {
+        let t = "{ 0.4 0.5 0.7 0.1 0.2 0.3 0.4 0.5 }";
+        let check = |v: f64| {
+            if v < 0.6 {
+                Ok(())
+            } else {
+                Err(format!("{v} too big"))
+            }
+        };
+        let e = TensorTree::parse_checked(3, t, &check).unwrap_err();
+        assert_eq!((e.message.as_str(), e.offset), ("0.7 too big", 10));
     }
 
     #[test]

@@ -327,6 +327,12 @@ impl Tree {
     /// minimum taken off (channels kept at least 1e-5 × the leaf's mean Y). Radiance skips the
     /// unreachable leaves of a rank-3 u′/v′ tree while rebuilding it, which leaves the new tree
     /// incomplete and drops it: the component is grey from then on.
+    ///
+    /// Leaf values of u′, v′ trees are checked on reading (v′ in (0, 0.75)); a mean can still come
+    /// out 0 where the box is tiny against a branch of the averaged tree (the averaging skips
+    /// overlaps below 1e-10 of a child). That leaf has no chromaticity: it takes no part in the
+    /// minimum, and a recoloured leaf becomes NaN, as in Radiance; a sampled pair that meets such
+    /// a leaf makes its row an error ([`SampledRow`] rows are never NaN).
     fn split_colour(&mut self) -> Lambertian {
         let none = Lambertian {
             y: 0.0,
@@ -350,6 +356,9 @@ impl Tree {
                 return;
             }
             let cmax = upper(cmin, csiz);
+            // A mean without a chromaticity gives NaN channels, which no comparison keeps: such
+            // a leaf takes no part in the minimum (as in Radiance 6.0a, whose output on a rank-4
+            // tree with 1/1024 Visible leaves under one-level u′/v′ trees this matches).
             let rgb = yuv_to_sharp(
                 f64::from(val),
                 avg_box(u, r, cmin, &cmax),
@@ -375,11 +384,12 @@ impl Tree {
                 }
                 let cmax = upper(cmin, csiz);
                 let yval = avg_box(&self.root, r, cmin, &cmax);
-                let mut rgb = if is_u {
-                    yuv_to_sharp(yval, f64::from(val), avg_box(v, r, cmin, &cmax))
+                let (um, vm) = if is_u {
+                    (f64::from(val), avg_box(v, r, cmin, &cmax))
                 } else {
-                    yuv_to_sharp(yval, avg_box(u, r, cmin, &cmax), f64::from(val))
+                    (avg_box(u, r, cmin, &cmax), f64::from(val))
                 };
+                let mut rgb = yuv_to_sharp(yval, um, vm);
                 for c in 0..3 {
                     rgb[c] -= min[c];
                     if f64::from(rgb[c]) < 1e-5 * yval {
@@ -744,6 +754,9 @@ pub enum SampledRow {
     Absent,
     /// Radiance stops the row without printing it (a sample fell on the disk's rim).
     Dropped,
+    /// A sampled pair met a colour leaf without a chromaticity (its value is NaN; Radiance
+    /// prints NaN): reported as an error.
+    NoColour,
 }
 
 struct Stats {
@@ -751,6 +764,8 @@ struct Stats {
     hi: f64,
     sum: f64,
     n: u64,
+    /// A pair without a value (a colour leaf without chromaticity).
+    nan: bool,
 }
 
 impl Loaded {
@@ -846,6 +861,7 @@ impl Loaded {
         } else {
             (other - y) / (other + FTINY)
         };
+        st.nan |= e.is_nan();
         st.lo = st.lo.min(e);
         st.hi = st.hi.max(e);
         st.sum += e;
@@ -872,6 +888,7 @@ impl Loaded {
             hi: -1e10,
             sum: 0.0,
             n: 0,
+            nan: false,
         };
         let ok = if self.rank == 3 {
             let w = df.smallest_leaf();
@@ -906,6 +923,9 @@ impl Loaded {
         };
         if !ok {
             return SampledRow::Dropped;
+        }
+        if st.nan {
+            return SampledRow::NoColour;
         }
         if st.n == 0 {
             return SampledRow::Absent;
