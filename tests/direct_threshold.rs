@@ -193,6 +193,22 @@ fn thresholded_output_is_the_same_for_any_thread_count() {
 }
 
 #[test]
+fn certainty_above_one_weighs_the_whole_rest() {
+    // n^dc is capped at the n samples: -dc 2 or 50 weigh all the untested rest, as -dc 1
+    // (Radiance 6.0a: -dc 2 and 5 give its -dc 1 output on this scene; from -dc 8, 60^dc
+    // overflows its int and it crashes). Before the cap, -dc 50 stopped after 2 tests.
+    let dir = common::fixture(FIXTURE);
+    let rays = points();
+    let one = run(&dir, &["-h", "-I+", "-dt", ".05", "-dc", "1"], &rays).0;
+    let dc_half = run(&dir, &["-h", "-I+", "-dt", ".05", "-dc", ".5"], &rays).0;
+    assert!(one != dc_half, "-dc has no effect on this scene");
+    for dc in ["2", "50", "1e300"] {
+        let many = run(&dir, &["-h", "-I+", "-dt", ".05", "-dc", dc], &rays).0;
+        assert!(one == many, "-dc {dc} differs from -dc 1");
+    }
+}
+
+#[test]
 fn verbose_says_when_thresholding_is_on() {
     let dir = common::fixture(FIXTURE);
     let rays = points();

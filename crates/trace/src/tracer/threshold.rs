@@ -668,7 +668,10 @@ impl Tracer {
         for k in (0..n).rev() {
             tail[k] = tail[k + 1] + cands[k].brt;
         }
-        let check = ((n as f64).powf(self.opts.dc) + 0.5) as usize;
+        // how many of the next potentials are weighed against the threshold: n^dc
+        // rounded, at most all n (-dc > 1 weighs the whole rest, as -dc 1 does; Radiance
+        // does the same until n^dc overflows its int, then it crashes); NaN gives 0
+        let check = ((n as f64).powf(self.opts.dc) + 0.5).min(n as f64) as usize;
         let thresh = self.opts.dt / r.weight;
         let mut gathered = prior;
         let mut total = DVec3::ZERO;
@@ -677,7 +680,7 @@ impl Tracer {
         while tested < n {
             let k = tested;
             if k >= MIN_TESTS {
-                let rest = if k + check >= n {
+                let rest = if k.saturating_add(check) >= n {
                     tail[k]
                 } else {
                     tail[k] - tail[k + check]
