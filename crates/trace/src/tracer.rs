@@ -620,7 +620,7 @@ impl Tracer {
             rays: 0,
             tracked: &[],
             sink: None,
-            ds: self.thresholding().then_some(st),
+            ds: self.state_for(st),
         };
         let d = dir.normalize_or_zero();
         if d == DVec3::ZERO {
@@ -650,7 +650,7 @@ impl Tracer {
             rays: 0,
             tracked: &[],
             sink: None,
-            ds: self.thresholding().then_some(st),
+            ds: self.state_for(st),
         };
         let n = normal.normalize_or_zero();
         if n == DVec3::ZERO {

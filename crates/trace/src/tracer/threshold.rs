@@ -65,26 +65,28 @@ pub(super) struct Candidate {
 }
 
 /// Hit statistics and obstructor caches of source thresholding, carried from one input
-/// ray to the next (see the module documentation).
+/// ray to the next (see the module documentation). Made by [`Tracer::direct_state`] for
+/// that tracer's sources.
 ///
 /// A state can be [`fork`](Self::fork)ed into states that go on from it independently
 /// (one per block of records, traced in parallel), whose changes are then
 /// [`merge`](Self::merge)d back in a fixed order: the counts added, the cache cells each
 /// set in turn. That keeps a whole run's statistics, as Radiance does, while the result
 /// does not depend on which thread traced which block.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub struct DirectState {
     ntests: Vec<u64>,
     nhits: Vec<u64>,
     /// Counts when forked (merging adds the difference).
     ntests0: Vec<u64>,
     nhits0: Vec<u64>,
-    /// Per source: cells changed before the fork ([`UNCAST`]: the initial cell).
-    shared: Arc<Vec<Option<Vec<u32>>>>,
-    /// Per source: cells changed since the fork (copied from `shared` on first change).
-    cache: Vec<Option<Vec<u32>>>,
-    /// The changes since the fork, in order: (source, cell, value); not kept by a state
-    /// that was not forked (nothing merges it).
+    /// Per source: the number of cells of its obstructor cache (0: not cached).
+    lens: Arc<[usize]>,
+    /// Per source: the cells as this state has them ([`UNCAST`]: the initial cell; None:
+    /// all initial). Shared with forks until one side changes a source's cells.
+    cells: Arc<Vec<Option<Arc<Vec<u32>>>>>,
+    /// The cell changes since the fork, in order: (source, cell, value); not kept by a
+    /// state that was not forked (nothing merges it).
     log: Vec<(usize, usize, u32)>,
     forked: bool,
     cands: Vec<Candidate>,
@@ -92,24 +94,43 @@ pub struct DirectState {
 }
 
 impl DirectState {
+    /// A fresh state for `lens.len()` sources (every one at a 1/2 hit rate, initial caches
+    /// of `lens[si]` cells).
+    fn new(lens: Vec<usize>) -> DirectState {
+        let n = lens.len();
+        DirectState {
+            ntests: vec![2; n],
+            nhits: vec![1; n],
+            ntests0: vec![2; n],
+            nhits0: vec![1; n],
+            lens: lens.into(),
+            cells: Arc::new(vec![None; n]),
+            log: Vec::new(),
+            forked: false,
+            cands: Vec::new(),
+            tail: Vec::new(),
+        }
+    }
+
+    /// Number of sources this state is for.
+    pub(super) fn sources(&self) -> usize {
+        self.lens.len()
+    }
+
     fn rate(&self, si: usize) -> f64 {
         self.nhits[si] as f64 / self.ntests[si] as f64
     }
 
     /// Cell `k` of source `si`'s cache as this state has it ([`UNCAST`]: initial).
     fn cell(&self, si: usize, k: usize) -> u32 {
-        [&self.cache[si], &self.shared[si]]
-            .into_iter()
-            .flatten()
-            .map(|c| c[k])
-            .find(|&v| v != UNCAST)
-            .unwrap_or(UNCAST)
+        self.cells[si].as_ref().map_or(UNCAST, |c| c[k])
     }
 
-    fn set_cell(&mut self, si: usize, k: usize, v: u32, len: usize) {
-        let shared = &self.shared;
-        self.cache[si]
-            .get_or_insert_with(|| shared[si].clone().unwrap_or_else(|| vec![UNCAST; len]))[k] = v;
+    fn set_cell(&mut self, si: usize, k: usize, v: u32) {
+        let len = self.lens[si];
+        let c =
+            Arc::make_mut(&mut self.cells)[si].get_or_insert_with(|| Arc::new(vec![UNCAST; len]));
+        Arc::make_mut(c)[k] = v;
         if self.forked {
             self.log.push((si, k, v));
         }
@@ -117,26 +138,13 @@ impl DirectState {
 
     /// A state that goes on from this one (its statistics and caches as they are now).
     pub fn fork(&self) -> DirectState {
-        self.fork_keeping(self.ntests.clone(), self.nhits.clone())
-    }
-
-    fn fork_keeping(&self, ntests: Vec<u64>, nhits: Vec<u64>) -> DirectState {
-        let mut shared = self.shared.clone();
-        if self.cache.iter().any(Option::is_some) {
-            let s = Arc::make_mut(&mut shared);
-            for (si, c) in self.cache.iter().enumerate() {
-                if let Some(c) = c {
-                    s[si] = Some(c.clone());
-                }
-            }
-        }
         DirectState {
-            ntests0: ntests.clone(),
-            nhits0: nhits.clone(),
-            ntests,
-            nhits,
-            shared,
-            cache: vec![None; self.cache.len()],
+            ntests: self.ntests.clone(),
+            nhits: self.nhits.clone(),
+            ntests0: self.ntests.clone(),
+            nhits0: self.nhits.clone(),
+            lens: self.lens.clone(),
+            cells: self.cells.clone(),
             log: Vec::new(),
             forked: true,
             cands: Vec::new(),
@@ -144,33 +152,23 @@ impl DirectState {
         }
     }
 
-    /// Adds what `child` (forked from this state) learnt: its test and hit counts, then
-    /// its cache changes in the order it made them. Merging the children of one fork in
-    /// a fixed order gives the same state whatever order they were traced in.
+    /// Adds what `child` (forked from this state, or from a state forked from it before
+    /// it changed) learnt: its test and hit counts, then its cache changes in the order it
+    /// made them, over this state's own. Merging the children of one fork in a fixed order
+    /// gives the same state whatever order they were traced in.
     pub fn merge(&mut self, child: DirectState) {
+        assert_eq!(
+            child.sources(),
+            self.sources(),
+            "DirectState::merge: states of different tracers"
+        );
         for si in 0..self.ntests.len() {
             self.ntests[si] += child.ntests[si] - child.ntests0[si];
             self.nhits[si] += child.nhits[si] - child.nhits0[si];
         }
-        if child.log.is_empty() {
-            return;
-        }
-        if self.cache.iter().any(Option::is_some) {
-            // this state's own changes go first (it was traced with, then merged into)
-            let mut own = self.fork_keeping(self.ntests.clone(), self.nhits.clone());
-            own.ntests0 = std::mem::take(&mut self.ntests0);
-            own.nhits0 = std::mem::take(&mut self.nhits0);
-            own.log = std::mem::take(&mut self.log);
-            own.forked = self.forked;
-            *self = own;
-        }
-        let shared = Arc::make_mut(&mut self.shared);
-        for &(si, k, v) in &child.log {
-            let len = child.cache[si].as_ref().map_or(0, Vec::len);
-            shared[si].get_or_insert_with(|| vec![UNCAST; len])[k] = v;
-        }
-        if self.forked {
-            self.log.extend(child.log);
+        let log = child.log;
+        for (si, k, v) in log {
+            self.set_cell(si, k, v);
         }
     }
 }
@@ -340,25 +338,31 @@ impl Tracer {
         self.obs.is_some()
     }
 
-    /// A fresh thresholding state (every source at a 1/2 hit rate, initial caches).
+    /// A fresh thresholding state (every source at a 1/2 hit rate, initial caches); with
+    /// thresholding off, a state for no sources (never used).
     pub fn direct_state(&self) -> DirectState {
-        let n = if self.thresholding() {
-            self.sources.len()
-        } else {
-            0
-        };
-        DirectState {
-            ntests: vec![2; n],
-            nhits: vec![1; n],
-            ntests0: vec![2; n],
-            nhits0: vec![1; n],
-            shared: Arc::new(vec![None; n]),
-            cache: vec![None; n],
-            log: Vec::new(),
-            forked: false,
-            cands: Vec::new(),
-            tail: Vec::new(),
-        }
+        DirectState::new(match &self.obs {
+            Some(obs) => obs
+                .iter()
+                .map(|c| c.as_ref().map_or(0, |c| c.cells.len()))
+                .collect(),
+            None => Vec::new(),
+        })
+    }
+
+    /// The state a ray carries (None with thresholding off). Panics if `st` was not made
+    /// by this tracer's [`direct_state`](Self::direct_state) (its caches would not fit).
+    pub(super) fn state_for<'a>(&self, st: &'a mut DirectState) -> Option<&'a mut DirectState> {
+        let obs = self.obs.as_ref()?;
+        assert!(
+            st.sources() == obs.len()
+                && obs
+                    .iter()
+                    .zip(st.lens.iter())
+                    .all(|(c, &n)| c.as_ref().map_or(0, |c| c.cells.len()) == n),
+            "a DirectState made by another tracer"
+        );
+        Some(st)
     }
 
     /// Whether thresholding applies to this scene and these options.
@@ -539,7 +543,7 @@ impl Tracer {
             return;
         };
         if self.blocker[h.shape] && !self.own_emitter(si, h.shape) {
-            st.set_cell(si, k, h.shape as u32 + 1, oc.cells.len());
+            st.set_cell(si, k, h.shape as u32 + 1);
         }
     }
 
@@ -770,6 +774,85 @@ mod tests {
                 assert_eq!(g.cell(p, -u), Some(k), "{g:?} cell {k}");
             }
         }
+    }
+
+    /// Every cell of every source of `st` (sources with `lens` cells).
+    fn all_cells(st: &DirectState) -> Vec<Vec<u32>> {
+        (0..st.sources())
+            .map(|si| (0..st.lens[si]).map(|k| st.cell(si, k)).collect())
+            .collect()
+    }
+
+    #[test]
+    fn nested_forks_merge_up() {
+        let mut base = DirectState::new(vec![10, 0, 5]);
+        let mut a = base.fork();
+        a.set_cell(0, 3, 7);
+        a.ntests[0] += 2;
+        a.nhits[0] += 1;
+        let mut g = a.fork();
+        // the grandchild changes a source its parent never touched
+        g.set_cell(2, 4, 9);
+        g.ntests[2] += 1;
+        a.merge(g);
+        a.set_cell(0, 3, 8);
+        base.merge(a);
+        assert_eq!(base.cell(0, 3), 8);
+        assert_eq!(base.cell(2, 4), 9);
+        let set: usize = all_cells(&base)
+            .iter()
+            .flatten()
+            .filter(|&&v| v != UNCAST)
+            .count();
+        assert_eq!(set, 2);
+        assert_eq!(base.ntests, [4, 2, 3]);
+        assert_eq!(base.nhits, [2, 1, 1]);
+    }
+
+    #[test]
+    fn merge_order_decides_a_cell_both_children_set() {
+        let base = DirectState::new(vec![4, 4]);
+        let (mut x, mut y) = (base.fork(), base.fork());
+        x.set_cell(0, 1, 5);
+        x.ntests[1] += 3;
+        y.set_cell(0, 1, 6);
+        y.set_cell(1, 2, 3);
+        y.nhits[1] += 1;
+        let (mut xy, mut yx) = (base.clone(), base.clone());
+        xy.merge(x.clone());
+        xy.merge(y.clone());
+        yx.merge(y);
+        yx.merge(x);
+        assert_eq!(xy.cell(0, 1), 6);
+        assert_eq!(yx.cell(0, 1), 5);
+        assert_eq!(xy.cell(1, 2), 3);
+        assert_eq!(yx.cell(1, 2), 3);
+        assert_eq!((&xy.ntests, &xy.nhits), (&yx.ntests, &yx.nhits));
+        assert_eq!(xy.ntests, [2, 5]);
+        assert_eq!(xy.nhits, [1, 2]);
+        // the children's changes never reached the state they were forked from
+        assert!(all_cells(&base).iter().flatten().all(|&v| v == UNCAST));
+    }
+
+    #[test]
+    fn merged_changes_go_over_the_states_own() {
+        // a forked state traced with (own changes) and then merging a child forked from it
+        // earlier: the child's changes come after its own, and both are passed on up
+        let mut base = DirectState::new(vec![4]);
+        let mut p = base.fork();
+        let mut c = p.fork();
+        p.set_cell(0, 1, 4);
+        p.set_cell(0, 2, 4);
+        c.set_cell(0, 1, 9);
+        // the child does not see its parent's later changes
+        assert_eq!(c.cell(0, 2), UNCAST);
+        p.merge(c);
+        assert_eq!((p.cell(0, 1), p.cell(0, 2)), (9, 4));
+        assert_eq!(p.log, [(0, 1, 4), (0, 2, 4), (0, 1, 9)]);
+        base.merge(p);
+        assert_eq!(all_cells(&base), [[UNCAST, 9, 4, UNCAST]]);
+        // an unforked state keeps no log
+        assert!(base.log.is_empty());
     }
 
     #[test]
