@@ -49,8 +49,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         let path = fenestra_cli::raypath::find(f).unwrap_or_else(|| Path::new(f).into());
         let b = fenestra_bsdf::read_file(&path).map_err(|e| anyhow!("{e}"))?;
         let colour = fenestra_bsdf::radiance::colour_lambertians(&b, &mut rng);
-        let xml = std::fs::read_to_string(&path).map_err(|e| anyhow!("{}: {e}", path.display()))?;
-        let trees = TreeFile::load(&xml).map_err(|e| anyhow!("{}: {e}", path.display()))?;
+        let trees = TreeFile::load(&b);
         let text = report(f, &b, &colour, trees, &mut rng)?;
         out.write_all(text.as_bytes())?;
         out.flush()?;
@@ -108,12 +107,7 @@ fn report(
 ) -> Result<String> {
     let mut s = String::new();
     let comp = |d| match &trees {
-        Some(t) => t.component(match d {
-            Direction::ReflectionBack => 0,
-            Direction::ReflectionFront => 1,
-            Direction::TransmissionBack => 2,
-            Direction::TransmissionFront => 3,
-        }),
+        Some(t) => t.component(d),
         None => check::component_with(b, d, colour),
     };
     let (rf, rb) = (
@@ -124,7 +118,6 @@ fn report(
         comp(Direction::TransmissionBack),
         comp(Direction::TransmissionFront),
     );
-    let totals = [&rf, &rb, &tf, &tb].map(|c| c.as_ref().map(|c| c.max_total));
     // Radiance drops a component whose largest directional total, its Lambertian part removed,
     // is at most 0.001; the split-off part still prints (as a missing transmission's).
     let dropped = |c: &ComponentCheck| c.max_total - c.lambertian_xyz[1] <= 0.001;
@@ -150,9 +143,7 @@ fn report(
         data_type(b)
     };
     writeln!(s, "Type: {kind}")?;
-    let colour_flag = trees
-        .as_ref()
-        .map_or(b.has_colour(), |t| t.colour_flag(totals));
+    let colour_flag = trees.as_ref().map_or(b.has_colour(), TreeFile::colour_flag);
     writeln!(s, "Color: {}", u8::from(colour_flag))?;
     let geom = b
         .geometry
@@ -221,7 +212,7 @@ fn report(
         // Tensor trees: Radiance's sampled rows, reproduced (check::sampled).
         for (label, r) in ["Interior Refl", "Exterior Refl", "Transmission"]
             .into_iter()
-            .zip(t.rows(totals, rng))
+            .zip(t.rows(rng))
         {
             match r {
                 SampledRow::Values(r) => rec(&mut s, label, Some(r)),

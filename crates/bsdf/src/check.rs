@@ -52,10 +52,7 @@ pub fn radiance_min(m: &KlemsMatrix) -> f64 {
     let mut min = 1e10f32;
     for i in 0..ni {
         for o in 0..no {
-            let d = (2 * ni) as f64 / (i as f64 + 0.22545) + (4 * no) as f64 / (o as f64 + 0.70281);
-            let d = d - d.trunc();
-            let v = (f64::from(m.get(o, i).max(0.0) as f32) * (1.0 + 6e-4 * (d - 0.5))) as f32;
-            min = min.min(v);
+            min = min.min(crate::radiance::jittered(m, o, i));
         }
     }
     f64::from(min)
@@ -227,87 +224,6 @@ pub fn energy_balance(b: &Bsdf, exterior: bool) -> Option<(f64, usize)> {
             _ => Some(x),
         },
     )
-}
-
-/// Summarises the `Visible` tensor tree of `d` (`None` when absent or not a tree): the
-/// Lambertian part is π × the smallest value (when between [`LAMBERTIAN_MIN`] and
-/// [`TREE_LAMBERTIAN_MAX`]); totals integrate
-/// the tree exactly on its finest grid (the square ↔ disk map preserves projected solid
-/// angle: a cell of area `a` covers `π·a`); the angle is `2 × the finest cell size` radians.
-pub fn tree_component(b: &Bsdf, d: Direction) -> Option<ComponentCheck> {
-    let blk = b.block(d, &Wavelength::Visible)?;
-    let t = match &blk.data {
-        crate::model::BlockData::Tree(t) => t,
-        crate::model::BlockData::Klems(_) => return None,
-    };
-    let cell = t.finest_cell();
-    let n = (1.0 / cell).round().max(1.0) as usize;
-    let c = |k: usize| (k as f64 + 0.5) / n as f64;
-    // Directional totals per incident cell on the finest grid (rank 3: incident position
-    // 0.5 − r/2 covers [0, 0.5): r = 1 (grazing) … 0 (normal)); for rank 3 the same lookups
-    // give the smallest value over the part of the tree that directions reach.
-    let mut min3 = f64::INFINITY;
-    let mut hemi = |inc: &[f64]| -> f64 {
-        let mut sum = 0.0;
-        let mut pos = [0.0; 4];
-        let r = inc.len();
-        pos[..r].copy_from_slice(inc);
-        for a in 0..n {
-            for bb in 0..n {
-                pos[r] = c(a);
-                pos[r + 1] = c(bb);
-                let v = t.lookup(&pos[..r + 2]);
-                min3 = min3.min(v);
-                sum += v;
-            }
-        }
-        std::f64::consts::PI * sum / (n * n) as f64
-    };
-    let mut totals = Vec::new();
-    if t.rank() == 3 {
-        for j in 0..n.div_ceil(2) {
-            totals.push(hemi(&[c(j)]));
-        }
-    } else {
-        for i in 0..n {
-            for j in 0..n {
-                totals.push(hemi(&[c(i), c(j)]));
-            }
-        }
-    }
-    let normal_rank4 = (t.rank() == 4).then(|| hemi(&[0.5, 0.5]));
-    let min = if t.rank() == 3 { min3 } else { t.min_value() };
-    // Radiance splits nothing off a tree whose minimum reaches TREE_LAMBERTIAN_MAX.
-    let split = min > LAMBERTIAN_MIN && min < TREE_LAMBERTIAN_MAX;
-    let y = if split {
-        std::f64::consts::PI * min
-    } else {
-        0.0
-    };
-    let max_total = totals.iter().copied().fold(0.0, f64::max);
-    let normal_total = normal_rank4.unwrap_or_else(|| totals.last().copied().unwrap_or(0.0));
-    // Diffuse incidence: incident cells weighted by their projected solid angle (uniform in
-    // the square for rank 4; for rank 3 the cell j covers radii r in [1 − 2(j+1)/n, 1 − 2j/n]).
-    let diffuse_total = if t.rank() == 3 {
-        let mut acc = 0.0;
-        for (j, tot) in totals.iter().enumerate() {
-            let r_hi = (1.0 - 2.0 * j as f64 / n as f64).clamp(0.0, 1.0);
-            let r_lo = (1.0 - 2.0 * (j + 1) as f64 / n as f64).clamp(0.0, 1.0);
-            acc += tot * (r_hi * r_hi - r_lo * r_lo);
-        }
-        acc
-    } else {
-        totals.iter().sum::<f64>() / totals.len().max(1) as f64
-    };
-    Some(ComponentCheck {
-        lambertian_xyz: [y; 3],
-        lambertian_y: if split { min } else { 0.0 },
-        max_total,
-        min_angle_deg: (2.0 * cell).to_degrees(),
-        normal_total,
-        diffuse_total,
-        totals,
-    })
 }
 
 #[cfg(test)]

@@ -252,9 +252,9 @@ fn encode_chroma(
     x: &KlemsMatrix,
     z: &KlemsMatrix,
     rng: &mut Drand48,
-) -> Vec<Option<(f64, f64)>> {
+) -> Vec<(f64, f64)> {
     let (ni, no) = (y.incident.len(), y.outgoing.len());
-    let mut out = vec![None; ni * no];
+    let mut out = vec![(0.0, 0.0); ni * no];
     for k in (0..ni * no).rev() {
         let (o, i) = (k / ni, k % ni);
         let [xv, yv, zv] = [x.get(o, i), y.get(o, i), z.get(o, i)].map(|v| v.max(0.0) as f32);
@@ -264,14 +264,25 @@ fn encode_chroma(
         } else {
             ((1.0f64 / 3.0) as f32, (1.0f64 / 3.0) as f32)
         };
-        out[k] = Some(encode_xy(cx, cy, rng));
+        out[k] = encode_xy(cx, cy, rng);
     }
     out
 }
 
-/// A coloured component's Lambertian split, as Radiance does it: each element's value (single
-/// precision, times Radiance's position factor `1 + 6e-4·(d − ½)`, d the fraction of
-/// `2·n_in/(i + 0.22545) + 4·n_out/(o + 0.70281)`) taken to Sharp RGB with each channel
+/// Element (o, i) of a Klems matrix as Radiance's loader holds it: the value (negative read as 0)
+/// in single precision, times a position factor `1 + 6e-4·(d − ½)` that keeps equal elements
+/// apart, d the fraction of `2·n_in/(i + 0.22545) + 4·n_out/(o + 0.70281)`, rounded to single
+/// precision again (found with the oracle: a constant matrix of π·value 12.351% gives a
+/// Lambertian 12.3%).
+pub(crate) fn jittered(m: &KlemsMatrix, o: usize, i: usize) -> f32 {
+    let (ni, no) = (m.incident.len(), m.outgoing.len());
+    let d = (2 * ni) as f64 / (i as f64 + 0.22545) + (4 * no) as f64 / (o as f64 + 0.70281);
+    let d = d - d.trunc();
+    (f64::from(m.get(o, i).max(0.0) as f32) * (1.0 + 6e-4 * (d - 0.5))) as f32
+}
+
+/// A coloured component's Lambertian split, as Radiance does it: each element's value
+/// ([`jittered`]) taken to Sharp RGB with each channel
 /// weighted by its primary's luminance (Radiance's four-decimal table); the per-channel minima
 /// are the Lambertian part when their sum exceeds 0.01/π. Each remainder (incident patch in the
 /// outer loop) is quantised again with two dither numbers, unless its luminance is at most
@@ -280,18 +291,15 @@ fn encode_chroma(
 /// part's CIE XYZ.
 fn split_colour(
     y: &KlemsMatrix,
-    chroma: &mut [Option<(f64, f64)>],
+    chroma: &mut [(f64, f64)],
     rng: &mut Drand48,
 ) -> Option<(Vec<f64>, [f64; 3])> {
     let w = XYZ_FROM_SHARP_F[1];
     let (ni, no) = (y.incident.len(), y.outgoing.len());
-    let coef = |chroma: &[Option<(f64, f64)>], i: usize, o: usize| -> [f32; 3] {
+    let coef = |chroma: &[(f64, f64)], i: usize, o: usize| -> [f32; 3] {
         let k = o * ni + i;
-        let d = (2 * ni) as f64 / (i as f64 + 0.22545) + (4 * no) as f64 / (o as f64 + 0.70281);
-        let d = d - d.trunc();
-        let v = (f64::from(y.values[k].max(0.0) as f32) * (1.0 + 6e-4 * (d - 0.5))) as f32;
-        let xy = decode_xy(chroma[k].unwrap_or((0.0, 0.0)));
-        let s = to_sharp(xy, f64::from(v));
+        let v = jittered(y, o, i);
+        let s = to_sharp(decode_xy(chroma[k]), f64::from(v));
         [s[0] * w[0], s[1] * w[1], s[2] * w[2]]
     };
     let mut min = [1e10f32; 3];
@@ -315,7 +323,7 @@ fn split_colour(
             let r = [0, 1, 2].map(|ch| (c[ch] - min[ch]) / w[ch]);
             if let (lum, Some((cx, cy))) = from_sharp(r) {
                 if lum > 1e-5 {
-                    chroma[k] = Some(encode_xy(cx, cy, rng));
+                    chroma[k] = encode_xy(cx, cy, rng);
                 }
             }
             rest[k] = f64::from(y.values[k].max(0.0) as f32 - ymin);
@@ -332,7 +340,7 @@ fn split_colour(
 /// Colour of a component: quantised chromaticity per element and, after a Lambertian split,
 /// the remainders' luminances and the Lambertian part's RGB.
 struct Colour {
-    chroma: Vec<Option<(f64, f64)>>,
+    chroma: Vec<(f64, f64)>,
     remainder: Option<Vec<f64>>,
     lambertian: [f64; 3],
 }
@@ -353,7 +361,7 @@ impl Component<'_> {
             return [y; 3];
         };
         let yr = c.remainder.as_ref().map_or(y, |r| r[k]);
-        let base = match c.chroma[k].and_then(|ch| chroma_xyz(ch, yr)) {
+        let base = match chroma_xyz(c.chroma[k], yr) {
             Some(xyz) => clip_gamut(mul3(&self.m, xyz), yr),
             None => [yr; 3],
         };

@@ -13,10 +13,69 @@ pub struct TensorTree {
     root: Node,
 }
 
+/// A tree node: a branch of `2^rank` children or a grid of `2^(rank·log2)` values.
 #[derive(Clone, Debug, PartialEq)]
-enum Node {
+pub(crate) enum Node {
     Branch(Vec<Node>),
     Grid { log2: u32, values: Vec<f32> },
+}
+
+/// A leaf found by a lookup: its value and its hypercube (lower corner, edge).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Leaf {
+    pub(crate) value: f32,
+    pub(crate) corner: [f64; 4],
+    pub(crate) edge: f64,
+}
+
+/// The leaf of `node` (a tree of rank `rank`) holding `pos` (each coordinate in [0, 1]; 1 falls
+/// in the last cell). A branch halves every dimension (child bit `i` set: upper half of
+/// dimension `i`); a grid picks the cell by truncation.
+pub(crate) fn leaf_at(node: &Node, rank: usize, pos: &[f64; 4]) -> Leaf {
+    let mut p = *pos;
+    let mut corner = [0.0; 4];
+    let mut edge = 1.0;
+    let mut node = node;
+    loop {
+        match node {
+            Node::Branch(ch) => {
+                edge *= 0.5;
+                let mut n = 0;
+                for i in (0..rank).rev() {
+                    let s = 2.0 * p[i];
+                    let t = usize::from(s >= 1.0);
+                    n |= t << i;
+                    p[i] = s - t as f64;
+                    corner[i] += t as f64 * edge;
+                }
+                node = &ch[n];
+            }
+            Node::Grid { log2, values } => {
+                if *log2 == 0 {
+                    return Leaf {
+                        value: values[0],
+                        corner,
+                        edge,
+                    };
+                }
+                let cells = (1u64 << log2) as f64;
+                let top = (1usize << log2) - 1;
+                let mut n = 0usize;
+                for v in &p[..rank] {
+                    n = (n << log2) + ((cells * v) as usize).min(top);
+                }
+                edge /= cells;
+                for i in (0..rank).rev() {
+                    corner[i] += (cells * p[i]).floor().min(top as f64) * edge;
+                }
+                return Leaf {
+                    value: values[n],
+                    corner,
+                    edge,
+                };
+            }
+        }
+    }
 }
 
 /// Finest leaf edge accepted in a tree: leaves smaller than 1/2^16 per dimension (branch levels
@@ -66,34 +125,18 @@ impl TensorTree {
         self.rank
     }
 
-    /// Value at a position in the unit hypercube (`pos.len() == rank`, each in [0,1]).
+    /// The root node.
+    pub(crate) fn root(&self) -> &Node {
+        &self.root
+    }
+
+    /// Value at a position in the unit hypercube (`pos.len() == rank`, each clamped to [0,1]).
     pub fn lookup(&self, pos: &[f64]) -> f64 {
-        let mut p: Vec<f64> = pos.iter().map(|v| v.clamp(0.0, 1.0)).collect();
-        let mut node = &self.root;
-        loop {
-            match node {
-                Node::Branch(ch) => {
-                    let mut idx = 0;
-                    for (i, v) in p.iter_mut().enumerate() {
-                        if *v >= 0.5 {
-                            idx |= 1 << i;
-                            *v = *v * 2.0 - 1.0;
-                        } else {
-                            *v *= 2.0;
-                        }
-                    }
-                    node = &ch[idx];
-                }
-                Node::Grid { log2, values } => {
-                    let n = 1usize << log2;
-                    let mut idx = 0;
-                    for v in &p {
-                        idx = idx * n + ((v * n as f64) as usize).min(n - 1);
-                    }
-                    return values[idx] as f64;
-                }
-            }
+        let mut p = [0.0; 4];
+        for (q, v) in p.iter_mut().zip(pos.iter().take(self.rank)) {
+            *q = v.clamp(0.0, 1.0);
         }
+        f64::from(leaf_at(&self.root, self.rank, &p).value)
     }
 
     /// BSDF (sr⁻¹) for an incident and an outgoing direction, both unit vectors pointing away
@@ -114,22 +157,9 @@ impl TensorTree {
         }
     }
 
-    /// Smallest value anywhere in the tree.
-    pub fn min_value(&self) -> f64 {
-        fn walk(n: &Node) -> f64 {
-            match n {
-                Node::Branch(ch) => ch.iter().map(walk).fold(f64::INFINITY, f64::min),
-                Node::Grid { values, .. } => values
-                    .iter()
-                    .map(|&v| v as f64)
-                    .fold(f64::INFINITY, f64::min),
-            }
-        }
-        walk(&self.root)
-    }
-
     /// Finest cell size along one dimension (1/2^depth).
-    pub fn finest_cell(&self) -> f64 {
+    #[cfg(test)]
+    pub(crate) fn finest_cell(&self) -> f64 {
         fn walk(n: &Node) -> f64 {
             match n {
                 Node::Branch(ch) => 0.5 * ch.iter().map(walk).fold(1.0, f64::min),
@@ -161,13 +191,13 @@ pub fn disk_to_square(x: f64, y: f64) -> (f64, f64) {
 }
 
 /// Shirley–Chiu concentric map from the unit square to the unit disk (inverse of
-/// [`disk_to_square`]).
+/// [`disk_to_square`]; radius scaled by 1 − 1e-13). The centre takes the last branch and maps to
+/// (−0, −0), which a rank-3 lookup turns by π where (+0, +0) is not turned; which of the two
+/// Radiance gives was not tested (checkBSDF's sampling draws the centre with probability 2^-48).
 pub fn square_to_disk(u: f64, v: f64) -> (f64, f64) {
     let a = 2.0 * u - 1.0;
     let b = 2.0 * v - 1.0;
-    let (r, phi) = if a == 0.0 && b == 0.0 {
-        (0.0, 0.0)
-    } else if a > -b {
+    let (r, phi) = if a > -b {
         if a > b {
             (a, FRAC_PI_4 * (b / a))
         } else {
