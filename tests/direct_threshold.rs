@@ -241,9 +241,41 @@ fn verbose_says_when_thresholding_is_on() {
     .unwrap();
     let (_, err1) = run(&sun, &["-h", "-I+", "-v"], "0 0 1 0 0 1\n");
     assert!(
-        err1.contains("source thresholding: off (-dt 0.03, but at most 2 source samples"),
+        err1.contains("source thresholding: off (-dt 0.03, but at most 1 source sample(s) per point and the first 2 are always tested)"),
         "{err1}"
     );
+    // a lamp sphere and the sun: 2 samples, both always tested; a third source, or a flat
+    // lamp (subdivided near it with -ds > 0), can give more
+    let scene = std::fs::read_to_string(sun.join("scene.rad")).unwrap();
+    let lamp = "void light lamp_m 0 0 3 50 50 50\nlamp_m sphere lamp 0 0 4 1 1 2.7 0.08\n";
+    let flat = "lamp_m polygon panel 0 0 12 -1 -1 2.9 -1 -0.5 2.9 -0.5 -0.5 2.9 -0.5 -1 2.9\n";
+    for (add, opts, on) in [
+        (lamp.to_string(), &[][..], false),
+        (
+            format!("{lamp}lamp_m sphere lamp2 0 0 4 3 1 2.7 0.08\n"),
+            &[][..],
+            true,
+        ),
+        (format!("{lamp}{flat}"), &[][..], true),
+        (format!("{lamp}{flat}"), &["-ds", "0"][..], true),
+        (
+            format!("void light lamp_m 0 0 3 50 50 50\n{flat}"),
+            &["-ds", "0"][..],
+            false,
+        ),
+    ] {
+        std::fs::write(sun.join("scene.rad"), format!("{scene}{add}")).unwrap();
+        let (_, err) = run(
+            &sun,
+            &[&["-h", "-I+", "-v"][..], opts].concat(),
+            "0 0 1 0 0 1\n",
+        );
+        assert_eq!(
+            err.contains("source thresholding: on"),
+            on,
+            "{add} {opts:?}: {err}"
+        );
+    }
 }
 
 #[test]

@@ -29,6 +29,8 @@ const REFLECTED: u8 = 2;
 const TRANS: u8 = 4;
 const AMBIENT: u8 = 8;
 const SPECULAR: u8 = 16;
+/// Most subdivisions per side of a flat source's samples (`-ds`).
+const MAX_DIVISIONS: usize = 16;
 
 /// One recorded contribution: a ray that reached a surface (or distant source) whose
 /// direct modifier is tracked.
@@ -507,7 +509,8 @@ impl Tracer {
                 .into()
         });
         let specular = specular || opts.full;
-        let threshold = direct && Self::wants_threshold(opts, &sources);
+        let most = Self::most_samples(opts, &sources, &shapes);
+        let threshold = direct && Self::wants_threshold(opts, most);
         notes.push(if threshold {
             format!(
                 "source thresholding: on (-dt {} -dc {}, {} source(s)): only the brightest source samples are shadow-tested",
@@ -516,7 +519,11 @@ impl Tracer {
                 sources.len()
             )
         } else if opts.dt > 0.0 && direct {
-            format!("source thresholding: off (-dt {}, but at most 2 source samples per point: all tested)", opts.dt)
+            format!(
+                "source thresholding: off (-dt {}, but at most {most} source sample(s) per point and the first {} are always tested)",
+                opts.dt,
+                threshold::MIN_TESTS
+            )
         } else {
             format!("source thresholding: off (-dt {}): every source sample is shadow-tested", opts.dt)
         });
@@ -1745,7 +1752,7 @@ impl Tracer {
         if self.opts.ds <= 0.0 || dist <= 0.0 {
             return 1;
         }
-        ((size / dist / self.opts.ds).ceil() as usize).clamp(1, 16)
+        ((size / dist / self.opts.ds).ceil() as usize).clamp(1, MAX_DIVISIONS)
     }
 
     /// Indirect diffuse light by stratified cosine-weighted hemisphere sampling (`-aa 0`),

@@ -365,13 +365,29 @@ impl Tracer {
         Some(st)
     }
 
-    /// Whether thresholding applies to this scene and these options.
-    pub(super) fn wants_threshold(opts: &TraceOptions, sources: &[Source]) -> bool {
-        opts.dt > 0.0
-            && (sources.len() > MIN_TESTS
-                || sources
-                    .iter()
-                    .any(|s| matches!(s.geom, SourceGeom::Local(_))))
+    /// The most source samples a point can get: one per sphere, distant or virtual
+    /// source; with `-ds > 0` up to [`MAX_DIVISIONS`]² per flat source (a point close
+    /// enough to it), else one.
+    pub(super) fn most_samples(opts: &TraceOptions, sources: &[Source], shapes: &[Shape]) -> usize {
+        sources
+            .iter()
+            .map(|s| match s.geom {
+                SourceGeom::Local(sh) => match shapes[sh] {
+                    Shape::Polygon(_) | Shape::Ring { .. } if opts.ds > 0.0 => {
+                        MAX_DIVISIONS * MAX_DIVISIONS
+                    }
+                    Shape::Cone { .. } => 0,
+                    _ => 1,
+                },
+                SourceGeom::Distant(_) | SourceGeom::Virtual { .. } => 1,
+            })
+            .fold(0, usize::saturating_add)
+    }
+
+    /// Whether thresholding applies: `-dt > 0` and more than [`MIN_TESTS`] samples at
+    /// some point (with fewer, all are tested anyway).
+    pub(super) fn wants_threshold(opts: &TraceOptions, most_samples: usize) -> bool {
+        opts.dt > 0.0 && most_samples > MIN_TESTS
     }
 
     /// The initial obstructor cache of every source (None: not cached — virtual sources,
