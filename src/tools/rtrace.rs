@@ -270,13 +270,14 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 })
                 .collect()
         });
-        let mut vals = Vec::with_capacity(end - start);
-        for (recs, st) in blocks {
-            vals.extend(recs);
-            if thresholding {
-                base.merge(st);
-            }
+        let (vals, states): (Vec<Vec<Vec<f64>>>, Vec<fenestra_trace::DirectState>) =
+            blocks.into_iter().unzip();
+        if thresholding {
+            // all of a wave at once: the blocks' states are dropped before their changes
+            // are applied, so the cache cells they shared are not copied
+            base.merge(states);
         }
+        let vals = vals.into_iter().flatten();
         for rec in vals {
             match fout {
                 Fmt::Ascii => {

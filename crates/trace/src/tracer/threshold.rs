@@ -152,22 +152,27 @@ impl DirectState {
         }
     }
 
-    /// Adds what `child` (forked from this state, or from a state forked from it before
-    /// it changed) learnt: its test and hit counts, then its cache changes in the order it
-    /// made them, over this state's own. Merging the children of one fork in a fixed order
-    /// gives the same state whatever order they were traced in.
-    pub fn merge(&mut self, child: DirectState) {
-        assert_eq!(
-            child.sources(),
-            self.sources(),
-            "DirectState::merge: states of different tracers"
-        );
-        for si in 0..self.ntests.len() {
-            self.ntests[si] += child.ntests[si] - child.ntests0[si];
-            self.nhits[si] += child.nhits[si] - child.nhits0[si];
+    /// Adds what `children` (forked from this state, or from a state forked from it
+    /// before it changed) learnt, in their order: their test and hit counts, then their
+    /// cache changes in the order they made them, over this state's own. Merging the
+    /// children of one fork in a fixed order gives the same state whatever order they
+    /// were traced in. The children are dropped before their changes are applied, so
+    /// cells they shared with this state are changed in place, not copied.
+    pub fn merge(&mut self, children: impl IntoIterator<Item = DirectState>) {
+        let mut logs = Vec::new();
+        for child in children {
+            assert_eq!(
+                child.sources(),
+                self.sources(),
+                "DirectState::merge: states of different tracers"
+            );
+            for si in 0..self.ntests.len() {
+                self.ntests[si] += child.ntests[si] - child.ntests0[si];
+                self.nhits[si] += child.nhits[si] - child.nhits0[si];
+            }
+            logs.push(child.log);
         }
-        let log = child.log;
-        for (si, k, v) in log {
+        for (si, k, v) in logs.into_iter().flatten() {
             self.set_cell(si, k, v);
         }
     }
@@ -810,9 +815,9 @@ mod tests {
         // the grandchild changes a source its parent never touched
         g.set_cell(2, 4, 9);
         g.ntests[2] += 1;
-        a.merge(g);
+        a.merge([g]);
         a.set_cell(0, 3, 8);
-        base.merge(a);
+        base.merge([a]);
         assert_eq!(base.cell(0, 3), 8);
         assert_eq!(base.cell(2, 4), 9);
         let set: usize = all_cells(&base)
@@ -835,10 +840,10 @@ mod tests {
         y.set_cell(1, 2, 3);
         y.nhits[1] += 1;
         let (mut xy, mut yx) = (base.clone(), base.clone());
-        xy.merge(x.clone());
-        xy.merge(y.clone());
-        yx.merge(y);
-        yx.merge(x);
+        xy.merge([x.clone()]);
+        xy.merge([y.clone()]);
+        yx.merge([y]);
+        yx.merge([x]);
         assert_eq!(xy.cell(0, 1), 6);
         assert_eq!(yx.cell(0, 1), 5);
         assert_eq!(xy.cell(1, 2), 3);
@@ -848,6 +853,36 @@ mod tests {
         assert_eq!(xy.nhits, [1, 2]);
         // the children's changes never reached the state they were forked from
         assert!(all_cells(&base).iter().flatten().all(|&v| v == UNCAST));
+    }
+
+    #[test]
+    fn a_wave_merged_at_once_changes_the_cells_in_place() {
+        let mut base = DirectState::new(vec![4, 4]);
+        let mut first = base.fork();
+        first.set_cell(0, 0, 1);
+        base.merge([first]);
+        let (table, cells0) = (
+            Arc::as_ptr(&base.cells),
+            Arc::as_ptr(base.cells[0].as_ref().unwrap()),
+        );
+        // a wave of children: each copies the cells it changes, the parent's are not
+        // copied again when their changes come back
+        let mut wave: Vec<DirectState> = (0..3).map(|_| base.fork()).collect();
+        wave[0].set_cell(0, 1, 5);
+        wave[2].set_cell(0, 1, 6);
+        wave[1].set_cell(1, 3, 2);
+        let mut one_by_one = base.clone();
+        for c in wave.clone() {
+            one_by_one.merge([c]);
+        }
+        base.merge(wave);
+        assert_eq!(Arc::as_ptr(&base.cells), table);
+        assert_eq!(Arc::as_ptr(base.cells[0].as_ref().unwrap()), cells0);
+        assert_eq!(
+            all_cells(&base),
+            [[1, 6, UNCAST, UNCAST], [UNCAST, UNCAST, UNCAST, 2]]
+        );
+        assert_eq!(all_cells(&base), all_cells(&one_by_one));
     }
 
     #[test]
@@ -862,10 +897,10 @@ mod tests {
         c.set_cell(0, 1, 9);
         // the child does not see its parent's later changes
         assert_eq!(c.cell(0, 2), UNCAST);
-        p.merge(c);
+        p.merge([c]);
         assert_eq!((p.cell(0, 1), p.cell(0, 2)), (9, 4));
         assert_eq!(p.log, [(0, 1, 4), (0, 2, 4), (0, 1, 9)]);
-        base.merge(p);
+        base.merge([p]);
         assert_eq!(all_cells(&base), [[UNCAST, 9, 4, UNCAST]]);
         // an unforked state keeps no log
         assert!(base.log.is_empty());
