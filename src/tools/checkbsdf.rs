@@ -110,11 +110,11 @@ fn report(
         Some(t) => t.component(d),
         None => check::component_with(b, d, colour),
     };
-    let (rf, rb) = (
+    let (int_refl, ext_refl) = (
         comp(Direction::ReflectionBack),
         comp(Direction::ReflectionFront),
     );
-    let (tf, tb) = (
+    let (int_ext, ext_int) = (
         comp(Direction::TransmissionBack),
         comp(Direction::TransmissionFront),
     );
@@ -122,7 +122,7 @@ fn report(
     // is at most 0.001; the split-off part still prints (as a missing transmission's).
     let dropped = |c: &ComponentCheck| c.max_total - c.lambertian_xyz[1] <= 0.001;
     let kept = |c: &Option<ComponentCheck>| c.as_ref().is_some_and(|c| !dropped(c));
-    let all_dropped = [&rf, &rb, &tf, &tb]
+    let all_dropped = [&int_refl, &ext_refl, &int_ext, &ext_int]
         .iter()
         .all(|c| c.as_ref().is_none_or(dropped));
     s.push_str("=====================================================\n");
@@ -174,8 +174,8 @@ fn report(
         Some(c) => line(s, label, c.lambertian_xyz, c.max_total, c.min_angle_deg),
         None => line(s, label, [0.0; 3], 0.0, 180.0),
     };
-    row(&mut s, "Interior Refl", &rf);
-    row(&mut s, "Exterior Refl", &rb);
+    row(&mut s, "Interior Refl", &int_refl);
+    row(&mut s, "Exterior Refl", &ext_refl);
     // Radiance keeps one Lambertian transmission for both sides: a missing transmission
     // component shows the other's, with that part's Y (a fraction, printed as is) as its largest
     // directional total.
@@ -189,11 +189,11 @@ fn report(
             (None, Some((l, m, a))) => line(s, label, l, m, a),
             _ => row(s, label, c),
         };
-    trow(&mut s, "Int->Ext Trans", &tf, &tb);
-    if tf.is_none() && tb.is_none() {
+    trow(&mut s, "Int->Ext Trans", &int_ext, &ext_int);
+    if int_ext.is_none() && ext_int.is_none() {
         s.push_str("Ext->Int Trans\t 0    0    0\t\t  0.0%\t\t180 deg\n");
     } else {
-        trow(&mut s, "Ext->Int Trans", &tb, &tf);
+        trow(&mut s, "Ext->Int Trans", &ext_int, &int_ext);
     }
     s.push_str("Component\tReciprocity Error (min avg max %)\n");
     let rec = |s: &mut String, label: &str, r: Option<Reciprocity>| {
@@ -229,19 +229,20 @@ fn report(
         rec(
             &mut s,
             "Interior Refl",
-            check::reflection_reciprocity(b, Direction::ReflectionBack).filter(|_| kept(&rf)),
+            check::reflection_reciprocity(b, Direction::ReflectionBack).filter(|_| kept(&int_refl)),
         );
         rec(
             &mut s,
             "Exterior Refl",
-            check::reflection_reciprocity(b, Direction::ReflectionFront).filter(|_| kept(&rb)),
+            check::reflection_reciprocity(b, Direction::ReflectionFront)
+                .filter(|_| kept(&ext_refl)),
         );
         let lamb = |c: &Option<ComponentCheck>| c.as_ref().map_or(0.0, |c| c.lambertian_y);
         rec(
             &mut s,
             "Transmission",
-            check::transmission_reciprocity_with(b, lamb(&tb), lamb(&tf))
-                .filter(|_| kept(&tf) && kept(&tb)),
+            check::transmission_reciprocity_with(b, lamb(&ext_int), lamb(&int_ext))
+                .filter(|_| kept(&int_ext) && kept(&ext_int)),
         );
     }
 
@@ -249,10 +250,10 @@ fn report(
     s.push_str("--- fenestra: hemispherical totals (Visible, fractions)\n");
     s.push_str("Component\tNormal\tDiffuse\n");
     for (label, c) in [
-        ("Interior Refl", &rf),
-        ("Exterior Refl", &rb),
-        ("Int->Ext Trans", &tf),
-        ("Ext->Int Trans", &tb),
+        ("Interior Refl", &int_refl),
+        ("Exterior Refl", &ext_refl),
+        ("Int->Ext Trans", &int_ext),
+        ("Ext->Int Trans", &ext_int),
     ] {
         match c {
             Some(c) => writeln!(s, "{label}\t{:.4}\t{:.4}", c.normal_total, c.diffuse_total)?,

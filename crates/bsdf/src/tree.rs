@@ -140,7 +140,7 @@ impl TensorTree {
     }
 
     /// BSDF (sr⁻¹) for an incident and an outgoing direction, both unit vectors pointing away
-    /// from the surface in the component's frame (Radiance's `SDqueryTre` coordinates).
+    /// from the surface in the component's frame (the frame Radiance's tree lookups use).
     pub fn eval(&self, inc: [f64; 3], out: [f64; 3]) -> f64 {
         if self.rank == 4 {
             let a = disk_to_square(-inc[0], -inc[1]);
