@@ -492,3 +492,68 @@ fn oracle_colour_with_lambertian_part() {
         "worst element {max:e} (99th percentile {q99:e})"
     );
 }
+
+/// A constant coloured matrix (CIE XYZ 2.9, 3.0, 3.3) with one element lowered to 80%, placed
+/// where Radiance's position factor is largest (+3e-4): the Lambertian part split off is the
+/// minimum of the position-scaled values, so that element's remainder (its plain value minus
+/// the part) is negative. Radiance warns `BTDF has 1 negatives` and counts it as zero; so do
+/// we: every channel of `rmtxop`'s matrix within 1e-6 of the oracle's (as in
+/// `oracle_colour_with_lambertian_part`; the negative remainder taken as it is gave 2.7e-4 on
+/// that element) and no negative value.
+#[test]
+fn oracle_negative_colour_remainder_is_zero() {
+    let Some(o) = common::oracle() else { return };
+    let dir = common::scratch("bsdf-colour-negative");
+    let full = KlemsBasis::full();
+    let n = full.len();
+    // The element (o, i) with the largest fraction of 2·n/(i + 0.22545) + 4·n/(o + 0.70281).
+    let frac = |o: usize, i: usize| {
+        let d = (2 * n) as f64 / (i as f64 + 0.22545) + (4 * n) as f64 / (o as f64 + 0.70281);
+        d - d.trunc()
+    };
+    let dip = (0..n * n)
+        .max_by(|&a, &b| frac(a / n, a % n).total_cmp(&frac(b / n, b % n)))
+        .unwrap();
+    let blocks = [
+        (Wavelength::CieX, 2.9),
+        (Wavelength::Visible, 3.0),
+        (Wavelength::CieZ, 3.3),
+    ]
+    .into_iter()
+    .map(|(wavelength, v)| {
+        let mut values = vec![v; n * n];
+        values[dip] = 0.8 * v;
+        Block {
+            wavelength,
+            direction: Direction::TransmissionFront,
+            data_type: "BTDF".into(),
+            data: BlockData::Klems(KlemsMatrix {
+                incident: full.clone(),
+                outgoing: full.clone(),
+                values,
+            }),
+        }
+    })
+    .collect();
+    let b = Bsdf {
+        name: "dip".into(),
+        blocks,
+        ..Default::default()
+    };
+    let p = dir.join("dip.xml");
+    std::fs::write(&p, klems_xml(&b, None).unwrap()).unwrap();
+    let t = transmission_matrix(&read_file(&p).unwrap()).unwrap();
+    let out = o.command("rmtxop").arg("-ff").arg(&p).output().unwrap();
+    assert!(out.status.success());
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("1 negatives"),
+        "the oracle no longer reports the negative remainder: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let theirs = parse_float_matrix(&out.stdout);
+    assert!(t.data.iter().flatten().all(|&v| v >= 0.0));
+    assert!(theirs.2.iter().flatten().all(|&v| v >= 0.0));
+    let worst = worst_matrix_difference("dip", &t, &theirs, false);
+    eprintln!("constant coloured matrix with a negative remainder: channels within {worst:.2e}");
+    assert!(worst < 1e-6, "channels differ by {worst:e}");
+}
