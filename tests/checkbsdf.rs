@@ -275,8 +275,8 @@ fn totals_and_energy_warning() {
 
 /// Tensor trees (genBSDF rank 3 and rank 4): Radiance's whole section equals the stored oracle
 /// output byte for byte: the component table (Lambertian part from the reachable part of the
-/// tree, largest directional total integrated exactly on the finest grid, angle from the finest
-/// cell) and the reciprocity rows, which Radiance samples with the process's `drand48()`
+/// tree, largest directional total as π × the largest mean over incident strips of the smallest
+/// leaf's width, at least 1/32; angle from the smallest leaf) and the reciprocity rows, which Radiance samples with the process's `drand48()`
 /// (blinds_t3: 0.0 23.0 69.3 / 0.0 11.3 46.3 / 0.0 45.2 100.0 from the generator's first
 /// state; blinds_t4: a reciprocal reflection tree and `0 0 0` for missing components).
 #[test]
