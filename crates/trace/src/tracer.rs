@@ -1648,16 +1648,35 @@ impl Tracer {
         val: &mut DVec3,
         cx: &mut Ctx,
     ) {
+        // (thresholding keeps samples down to maxc(coef) > 0 instead, see
+        // `direct_threshold`; each as it was, so neither output changes)
         if maxc(coef) <= FTINY {
             return;
         }
-        // Radiance starts shadow rays without a coefficient: they keep the parent's
-        // weight and are never subject to Russian roulette.
+        let c = self.shadow_ray(r, p, l, tmax, si, skip, coef);
+        *val += coef * self.trace(&c, cx);
+    }
+
+    /// The shadow ray from `p` (on surface `skip`, if flat) along `l` toward source `si`,
+    /// `tmax` long, with coefficient `coef`. Radiance starts shadow rays without a
+    /// coefficient: they keep the parent's weight and are never subject to Russian
+    /// roulette.
+    #[allow(clippy::too_many_arguments)]
+    fn shadow_ray(
+        &self,
+        r: &Ray,
+        p: DVec3,
+        l: DVec3,
+        tmax: f64,
+        si: usize,
+        skip: Option<usize>,
+        coef: DVec3,
+    ) -> Ray {
         let mut c = self.child(r, p, l, SHADOW, coef, skip, 0.0);
         c.weight = r.weight;
         c.src = Some(si);
         c.tmax = tmax;
-        *val += coef * self.trace(&c, cx);
+        c
     }
 
     /// Solid angle of a sphere (centre `c`, radius `r`) seen from `p` outside it.

@@ -663,13 +663,13 @@ impl Tracer {
                     return;
                 }
                 let coef = bsdf(s.l, s.omega, s.l.dot(nrm));
+                // any coefficient above 0 enters the sort and the counts (without
+                // thresholding, `Tracer::shadow` skips those up to FTINY; each is kept as
+                // it was, so neither output changes)
                 if maxc(coef) <= 0.0 {
                     return;
                 }
-                let mut c = self.child(r, p, s.l, SHADOW, DVec3::ONE, skip, 0.0);
-                c.weight = r.weight;
-                c.src = Some(si);
-                c.tmax = s.tmax;
+                let c = self.shadow_ray(r, p, s.l, s.tmax, si, skip, DVec3::ONE);
                 let val = coef * self.potential(&c, si, cx);
                 let brt = bright(val) as f32;
                 if brt > 0.0 {
@@ -718,10 +718,7 @@ impl Tracer {
             if let Some(st) = cx.ds.as_deref_mut() {
                 st.ntests[cd.si] += 1;
             }
-            let mut c = self.child(r, p, cd.l, SHADOW, cd.coef, skip, 0.0);
-            c.weight = r.weight;
-            c.src = Some(cd.si);
-            c.tmax = cd.tmax;
+            let c = self.shadow_ray(r, p, cd.l, cd.tmax, cd.si, skip, cd.coef);
             let v = self.trace(&c, cx);
             let Some(st) = cx.ds.as_deref_mut() else {
                 break;
