@@ -1,18 +1,22 @@
 //! The matrices Radiance's `dctimestep` and `rmtxop` build from a BSDF XML file.
 //!
 //! Transmission (`rmtxop file.xml`, T of `dctimestep V T D s`):
-//! * XML `Transmission Front` (Radiance `tb`, light from the exterior into the room) is used when
-//!   present: `T[o][i] = BSDF[o][i] · λ_in(i)`, rows = outgoing (room side) patches of the
-//!   RowAngleBasis, columns = incident patches of the ColumnAngleBasis.
-//! * Otherwise XML `Transmission Back` (`tf`) by reciprocity:
-//!   `T[r][c] = BSDF_tf[rot(c)][rot(r)] · λ(c)`, rot = the same-ring patch rotated by 180°;
-//!   rows follow the tf incident basis, columns its outgoing basis.
-//! * Neither (or only a Lambertian remainder, see below): a 145×145 matrix `m · λ_Full(c)`
-//!   where `m` is the Lambertian (minimum) value, zero if there is no transmission at all.
+//! * XML `Transmission Front` (light from the exterior into the room) is used when present and
+//!   not all Lambertian (see below): `T[o][i] = BSDF[o][i] · λ_in(i)`, rows = outgoing (room
+//!   side) patches of the RowAngleBasis, columns = incident patches of the ColumnAngleBasis.
+//! * Otherwise XML `Transmission Back` by reciprocity:
+//!   `T[r][c] = BSDF_back[rot(c)][rot(r)] · λ(c)`, rot = the same-ring patch rotated by 180°;
+//!   rows follow the back block's incident basis, columns its outgoing basis (a front block that
+//!   is all Lambertian is ignored then: found with the oracle).
+//! * Neither (or only Lambertian parts): a 145×145 matrix `m · λ_Full(c)` where `m` is the
+//!   Lambertian value (the front's when both are Lambertian; that case was not compared), zero if
+//!   there is no transmission at all.
 //!
-//! Radiance splits each component's minimum off as a Lambertian part when it exceeds 0.01/π and
-//! drops the remainder when its largest hemispherical total is ≤ 0.001; only that last case
-//! changes a transmission matrix (the split itself is added back), so it is what is reproduced.
+//! Radiance splits each component's minimum off as a Lambertian part when it exceeds 0.01/π
+//! (grey: the minimum of the position-scaled values (`jittered`), up to 3e-4 below the plain
+//! minimum) and drops the remainder when its largest hemispherical total is ≤ 0.001. A kept
+//! element is the part plus its remainder, a negative remainder (an element below the scaled
+//! minimum) counted as zero: grey elements are `max(value, part)`.
 //! Colour: with `CIE-X` and `CIE-Z` blocks Radiance keeps each element's CIE Y and stores its
 //! chromaticity (u′, v′) quantised to steps of 1/410 with a dither: from the single-precision
 //! (x, y) = (X, Y)/(X + Y + Z) of the float values, `k = trunc(410·u′ + r)` clamped to 0…255, r
@@ -354,6 +358,8 @@ struct Component<'a> {
     y: &'a KlemsMatrix,
     colour: Option<Colour>,
     m: [[f64; 3]; 3],
+    /// The Lambertian part split off a grey component (0 without a split).
+    grey_lamb: f64,
 }
 
 impl Component<'_> {
@@ -361,7 +367,8 @@ impl Component<'_> {
         let k = o * self.y.incident.len() + i;
         let y = self.y.values[k];
         let Some(c) = &self.colour else {
-            return [y; 3];
+            // Lambertian part plus the remainder, a negative remainder counted as zero.
+            return [y.max(self.grey_lamb); 3];
         };
         let yr = c.remainder.as_ref().map_or(y, |r| r[k]);
         // A remainder below zero (the split-off minimum is taken over position-scaled values, the
@@ -468,7 +475,17 @@ fn encode_all<'a>(b: &'a Bsdf, rng: &mut Drand48) -> [Slot<'a>; 4] {
             }
             _ => None,
         };
-        Slot::Klems(Component { y, colour, m })
+        let grey_lamb = if colour.is_none() {
+            lambertian_split(y).0
+        } else {
+            0.0
+        };
+        Slot::Klems(Component {
+            y,
+            colour,
+            m,
+            grey_lamb,
+        })
     })
 }
 
@@ -499,18 +516,22 @@ pub fn colour_lambertians(b: &Bsdf, rng: &mut Drand48) -> Vec<(Direction, [f64; 
     out
 }
 
-/// Lambertian value Radiance would split off a matrix (its minimum if > 0.01/π), and whether
-/// the remainder is kept (largest hemispherical total of the remainder > 0.001).
+/// Lambertian value Radiance splits off a grey matrix (the minimum of the position-scaled
+/// values, [`crate::check::radiance_min`], when above 0.01/π), and whether the remainder is kept
+/// (largest hemispherical total of the remainder, negative elements counted as zero, above
+/// 0.001).
 pub fn lambertian_split(m: &KlemsMatrix) -> (f64, bool) {
-    let min = m.values.iter().copied().fold(f64::INFINITY, f64::min);
-    let lamb = if min > 0.01 / std::f64::consts::PI {
+    let min = crate::check::radiance_min(m);
+    let lamb = if min > crate::check::LAMBERTIAN_MIN {
         min
     } else {
         0.0
     };
     let keep = (0..m.incident.len()).any(|i| {
         let h: f64 = (0..m.outgoing.len())
-            .map(|o| (m.get(o, i) - lamb) * m.outgoing.projected_solid_angle(o).unwrap_or(0.0))
+            .map(|o| {
+                (m.get(o, i) - lamb).max(0.0) * m.outgoing.projected_solid_angle(o).unwrap_or(0.0)
+            })
             .sum();
         h > 0.001
     });
@@ -530,10 +551,7 @@ pub fn transmission_matrix_with(b: &Bsdf, rng: &mut Drand48) -> Result<RgbMatrix
     // Radiance encodes every component once on load
     let mut slots = encode_all(b, rng);
     let tb = take(&mut slots, Direction::TransmissionFront)?;
-    let tf = match tb {
-        None => take(&mut slots, Direction::TransmissionBack)?,
-        Some(_) => None,
-    };
+    let mut tb_lamb = None;
     if let Some(tb) = tb {
         let (lamb, keep) = tb.split();
         if keep {
@@ -548,9 +566,11 @@ pub fn transmission_matrix_with(b: &Bsdf, rng: &mut Drand48) -> Result<RgbMatrix
             }
             return Ok(t);
         }
-        return Ok(lambertian_only(lamb));
+        tb_lamb = Some(lamb);
     }
-    if let Some(tf) = tf {
+    // Without `Transmission Front`, or with one that is all Lambertian (Radiance then takes
+    // `Transmission Back` alone: found with the oracle on a constant grey front block).
+    if let Some(tf) = take(&mut slots, Direction::TransmissionBack)? {
         let (lamb, keep) = tf.split();
         if keep {
             let (ni, no) = (tf.y.incident.len(), tf.y.outgoing.len());
@@ -572,9 +592,10 @@ pub fn transmission_matrix_with(b: &Bsdf, rng: &mut Drand48) -> Result<RgbMatrix
             }
             return Ok(t);
         }
-        return Ok(lambertian_only(lamb));
+        // Both all Lambertian: the front's part (not compared with Radiance).
+        return Ok(lambertian_only(tb_lamb.unwrap_or(lamb)));
     }
-    Ok(lambertian_only([0.0; 3]))
+    Ok(lambertian_only(tb_lamb.unwrap_or([0.0; 3])))
 }
 
 #[allow(clippy::needless_range_loop)]

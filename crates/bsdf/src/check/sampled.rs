@@ -23,7 +23,7 @@
 //! subtracted (float arithmetic), times Radiance's position-dependent factor `1 + 1e-4·d` that
 //! keeps equal leaves apart; a coloured component's value is the sum of its luminance-weighted
 //! Sharp RGB channels from the u′, v′ trees. The Lambertian parts are split off as Radiance's
-//! loader does (grey: the reachable minimum; coloured: [`Tree::split_colour`]). The generator is
+//! loader does (grey: the reachable minimum; coloured: `Tree::split_colour`). The generator is
 //! the process's one (the colour dither's): state runs on from file to file.
 
 use std::f64::consts::PI;
@@ -68,7 +68,7 @@ struct Tree {
     side: Side,
     root: Node,
     /// CIE u′ and v′ trees of a coloured component (Radiance loses them when a rank-3 coloured
-    /// component has a Lambertian part split off, see [`Tree::split_colour`]).
+    /// component has a Lambertian part split off, see `Tree::split_colour`).
     u: Option<Node>,
     v: Option<Node>,
     /// The last pair looked up (oriented directions, tree position, leaf): the sampling asks for
@@ -657,7 +657,7 @@ fn spin_z(v: [f64; 3], theta: f64) -> [f64; 3] {
 }
 
 /// The trees the reciprocity rows sample (dropped components left out) and the Lambertian parts
-/// (hemispherical fractions), indexed like [`SIDES`].
+/// (hemispherical fractions), indexed like `SIDES`.
 struct Loaded {
     rank: usize,
     trees: [Option<Tree>; 4],
@@ -898,7 +898,7 @@ pub struct Lambertian {
 }
 
 /// A tensor-tree file as the reference loads it: the `Visible` trees (and CIE-u/v trees of
-/// coloured components) with their Lambertian parts split off, indexed like [`SIDES`].
+/// coloured components) with their Lambertian parts split off, indexed like `SIDES`.
 pub struct TreeFile {
     rank: usize,
     trees: [Option<Tree>; 4],
