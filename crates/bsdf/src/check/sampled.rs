@@ -436,12 +436,13 @@ impl Tree {
                 if self.rank != 4 {
                     return None;
                 }
-                // Radiance's cumulative distribution for incident direction a: a tree used in
-                // reverse (light arriving on the other side) slices its outgoing dimensions.
-                let front = a[2] > 0.0;
+                // The slice the reference's sampling table for incident direction `a` covers: a
+                // tree used in reverse (light arriving on the other side) is sliced in its
+                // outgoing dimensions. The leaf width is rounded to 1/65536 as that table keeps it.
+                let interior = a[2] > 0.0;
                 let reverse = match self.side {
                     Side::IntRefl => {
-                        if !front {
+                        if !interior {
                             return Some(0.0);
                         }
                         false
