@@ -218,7 +218,7 @@ fn verbose_says_when_thresholding_is_on() {
         "{err}"
     );
     assert!(
-        err.contains("carried over the run, in blocks of 16 record(s)"),
+        err.contains("carried over the run, in blocks of 16 record(s) traced in waves of 1, 1, 2, 4, 8, then 16 blocks"),
         "{err}"
     );
     let (_, err_ab) = run(&dir, &["-h", "-I+", "-v", "-ab", "1", "-ad", "4"], &rays);

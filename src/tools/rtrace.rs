@@ -16,6 +16,16 @@ use rayon::prelude::*;
 /// traces many rays: they spread over the threads).
 const BLOCK_AB0: usize = 16;
 const WAVE_MAX: usize = 16;
+
+/// Blocks in wave `w` (0, 1, …) of a thresholded run: 1, then doubling from 1 up to
+/// [`WAVE_MAX`].
+fn wave_width(w: usize) -> usize {
+    if w == 0 {
+        1
+    } else {
+        (1usize << (w - 1).min(16)).min(WAVE_MAX)
+    }
+}
 /// Records per parallel batch without thresholding.
 const CHUNK: usize = 1024;
 
@@ -165,8 +175,9 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     for w in tracer.warnings() {
         fenestra_cli::warn(w);
     }
-    // With source thresholding the shadow-test statistics are carried from record to
-    // record within a block of BLOCK consecutive records, traced in order by one thread.
+    // With source thresholding the statistics are carried over the run: records in blocks
+    // (`block` consecutive records traced in order by one thread), blocks in waves of
+    // `wave_width` blocks, each block forked from the state merged from all earlier waves.
     let thresholding = tracer.thresholding();
     let block = if thresholding && o.ab == 0 {
         BLOCK_AB0
@@ -178,9 +189,15 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             eprintln!("{}: {n}", fenestra_cli::prog());
         }
         if thresholding {
+            let growing: Vec<String> = (0..)
+                .map(wave_width)
+                .take_while(|&w| w < WAVE_MAX)
+                .map(|w| w.to_string())
+                .collect();
             eprintln!(
-                "{}: source thresholding: hit statistics and obstructor caches carried over the run, in blocks of {block} record(s) traced in waves of 1, 1, 2, 4, 8, then {WAVE_MAX} blocks (each block starts from all earlier waves)",
-                fenestra_cli::prog()
+                "{}: source thresholding: hit statistics and obstructor caches carried over the run, in blocks of {block} record(s) traced in waves of {}, then {WAVE_MAX} blocks (each block starts from all earlier waves)",
+                fenestra_cli::prog(),
+                growing.join(", ")
             );
         }
     }
@@ -216,12 +233,10 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let mut base = tracer.direct_state();
     let (mut start, mut wave) = (0usize, 0usize);
     while start < n {
-        let width = if !thresholding {
-            CHUNK
-        } else if wave == 0 {
-            1
+        let width = if thresholding {
+            wave_width(wave)
         } else {
-            (1usize << (wave - 1).min(16)).min(WAVE_MAX)
+            CHUNK
         };
         let end = (start + width * block).min(n);
         let record = |k: usize, st: &mut fenestra_trace::DirectState| {
@@ -376,6 +391,13 @@ fn read_rays(fmt: Fmt) -> Result<Vec<(DVec3, DVec3)>> {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn waves_grow_to_the_most() {
+        let w: Vec<usize> = (0..8).map(super::wave_width).collect();
+        assert_eq!(w, [1, 1, 2, 4, 8, 16, 16, 16]);
+        assert_eq!(super::wave_width(usize::MAX), super::WAVE_MAX);
+    }
+
     #[test]
     fn c_style_exponent() {
         assert_eq!(super::fmt_e(1.23456789), "1.234568e+00");
