@@ -42,14 +42,16 @@ fn both(oracle: &common::Oracle, dir: &Path, opts: &str, rays: &str) -> (Vec<f64
 }
 
 // Tolerance: with -dt 0 (every sample tested) the two tools differ on this scene by
-// 8e-5 to 9.8e-5 per point (measured), all from the sphere sources' solid angle (fenestra
-// the exact cone 2π(1 − cos), Radiance πr²/d²). With thresholding, the same order of input
-// records and the same -dt/-dc, the measured worst is 1.03e-4 per point and 9.4e-5 in the
-// total (five -dt/-dc settings, five input orders). 3e-4 per point and 2e-4 in the total
+// up to 9.8e-5 per point (measured), all from the sphere sources' solid angle (fenestra
+// the exact cone 2π(1 − cos), Radiance πr²/d², r²/4d² apart per lamp: up to 2.2e-4 for
+// a point's nearest lamp, less over all the lamps it sees). With thresholding, the same
+// order of input records and the same -dt/-dc, the measured worst is 1.03e-4 per point
+// and 9.4e-5 in the total (at 679be5c: the four settings below and -dt .5, the three
+// scenes below and suns at 3e2 and 3e5, five input orders; docs/tools/rtrace.md). 3e-4 per point and 2e-4 in the total
 // leave room for that offset and rounding while staying far below what is tested: the
 // thresholding effect itself (oracle -dt .03 against its -dt 0: up to 2.6% per point, up
-// to 30% with -dt .3) and the oracle's own spread between input orders (up to 0.93% per
-// point), both asserted or measured below.
+// to 30% with -dt .3 -dc 0) and the oracle's own spread between input orders (up to 0.99%
+// per point), both asserted below.
 const PER_POINT: f64 = 3e-4;
 const TOTAL: f64 = 2e-4;
 
@@ -284,9 +286,10 @@ fn oracle_thresholding_with_an_ambient_bounce() {
     // they gather and to the ray's weight (1/256 here), with statistics carried over the
     // run. Both tools are random here, so the comparison is on the total over the points
     // of -dt .03 over that of -dt 0 (one run each), on 120 points (the fixture's 30 shifted
-    // 4 times by 1.3 cm). Measured over 4 runs: oracle 0.96696 (sd 0.00040 per run),
-    // fenestra 0.96661 (sd 0.00029); 0.004 is 7 standard deviations of the difference of
-    // two single runs above that mean difference, against an effect of 0.033. (Radiance's
+    // 4 times by 1.3 cm). Measured over 6 runs (at 679be5c): oracle 0.96702 (sd 0.00025 per
+    // run), fenestra 0.96649 (sd 0.00047, seeds 1 to 6); 0.004 is 6.4 standard deviations
+    // of the difference of two single runs above that mean difference, against an effect
+    // of 0.033. (Radiance's
     // own -n 2 moves this ratio by 0.002 to 0.0075 on these scenes: each process keeps its
     // own statistics.)
     let Some(oracle) = common::oracle() else {
