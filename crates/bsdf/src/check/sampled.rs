@@ -1102,6 +1102,46 @@ mod tests {
         assert_eq!(rng.next_f64(), want.next_f64());
     }
 
+    /// A colour leaf without a chromaticity (NaN, as a recoloured leaf becomes where a mean has
+    /// v′ = 0) makes the row [`SampledRow::NoColour`], never NaN statistics.
+    #[test]
+    fn nan_colour_leaf_is_reported() {
+        let grid = |v: f32| Node::Grid {
+            log2: 1,
+            values: vec![v; 8],
+        };
+        let mut u_values = vec![0.2f32; 8];
+        u_values[0] = f32::NAN;
+        let tree = Tree {
+            rank: 3,
+            side: Side::IntRefl,
+            root: grid(0.5),
+            u: Some(Node::Grid {
+                log2: 1,
+                values: u_values,
+            }),
+            v: Some(grid(0.47)),
+            memo: Memo::default(),
+        };
+        let mut loaded = Loaded {
+            rank: 3,
+            trees: [Some(tree), None, None, None],
+            lamb: [0.0; 4],
+        };
+        assert_eq!(
+            loaded.row(&mut Drand48::new(), 1.0, 1.0),
+            SampledRow::NoColour
+        );
+        // The same tree with a valid u′ leaf: values.
+        if let Some(t) = &mut loaded.trees[0] {
+            t.u = Some(grid(0.2));
+        }
+        assert!(matches!(
+            loaded.row(&mut Drand48::new(), 1.0, 1.0),
+            SampledRow::Values(_)
+        ));
+    }
+
     #[test]
     fn lambertian_split_and_lookup_cube() {
         let node = crate::tree::TensorTree::parse(
