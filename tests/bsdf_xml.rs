@@ -314,13 +314,7 @@ fn bad_values_are_errors_with_line() {
 /// or none, so that Radiance splits a coloured Lambertian part off it.
 fn coloured_xml(dir: &Path, split: bool) -> std::path::PathBuf {
     let (full, half) = (KlemsBasis::full(), KlemsBasis::half());
-    let mut seed = 0x2545_f491_4f6c_dd1du64;
-    let mut next = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = common::xorshift(0x2545_f491_4f6c_dd1du64);
     let mut blocks = Vec::new();
     for (direction, inc, out, zeros) in [
         (Direction::ReflectionBack, full, full, true),
@@ -497,14 +491,7 @@ fn oracle_negative_colour_remainder_is_zero() {
     let dir = common::scratch("bsdf-colour-negative");
     let full = KlemsBasis::full();
     let n = full.len();
-    // The element (o, i) with the largest fraction of 2·n/(i + 0.22545) + 4·n/(o + 0.70281).
-    let frac = |o: usize, i: usize| {
-        let d = (2 * n) as f64 / (i as f64 + 0.22545) + (4 * n) as f64 / (o as f64 + 0.70281);
-        d - d.trunc()
-    };
-    let dip = (0..n * n)
-        .max_by(|&a, &b| frac(a / n, a % n).total_cmp(&frac(b / n, b % n)))
-        .unwrap();
+    let dip = largest_position_factor(n);
     let blocks = [
         (Wavelength::CieX, 2.9),
         (Wavelength::Visible, 3.0),
@@ -561,13 +548,7 @@ fn oracle_grey_lambertian_split() {
     let dir = common::scratch("bsdf-grey-split");
     let full = KlemsBasis::full();
     let n = full.len();
-    let frac = |o: usize, i: usize| {
-        let d = (2 * n) as f64 / (i as f64 + 0.22545) + (4 * n) as f64 / (o as f64 + 0.70281);
-        d - d.trunc()
-    };
-    let dip = (0..n * n)
-        .max_by(|&a, &b| frac(a / n, a % n).total_cmp(&frac(b / n, b % n)))
-        .unwrap();
+    let dip = largest_position_factor(n);
     let front = synthetic(
         full,
         full,
@@ -605,4 +586,16 @@ fn assert_lambertian_close(
     let worst = worst_matrix_difference(tag, ours, theirs, false);
     eprintln!("{tag}: channels within {worst:.2e} of the oracle");
     assert!(worst < 4e-7, "{tag}: channels differ by {worst:e}");
+}
+
+/// The element (o·n + i) of an n×n Klems block with the largest fraction of
+/// 2·n/(i + 0.22545) + 4·n/(o + 0.70281): the largest position factor Radiance applies.
+fn largest_position_factor(n: usize) -> usize {
+    let frac = |o: usize, i: usize| {
+        let d = (2 * n) as f64 / (i as f64 + 0.22545) + (4 * n) as f64 / (o as f64 + 0.70281);
+        d - d.trunc()
+    };
+    (0..n * n)
+        .max_by(|&a, &b| frac(a / n, a % n).total_cmp(&frac(b / n, b % n)))
+        .unwrap()
 }

@@ -395,13 +395,7 @@ fn rescale_tree(tree: &str, f: impl Fn(f64) -> f64) -> String {
 fn oracle_random_tree_reciprocity() {
     let Some(o) = common::oracle() else { return };
     let dir = common::scratch("checkbsdf-random-trees");
-    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-    let mut next = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = common::xorshift(0x9e37_79b9_7f4a_7c15u64);
     let (rb, rf, tf, tb) = (
         "Reflection Back",
         "Reflection Front",
@@ -519,13 +513,7 @@ fn chain_tree(next: &mut dyn FnMut() -> f64, rank: usize, depth: u32, child: usi
 fn oracle_deep_trees() {
     let Some(o) = common::oracle() else { return };
     let dir = common::scratch("checkbsdf-deep-trees");
-    let mut seed = 0x2545_f491_4f6c_dd1du64;
-    let mut next = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = common::xorshift(0x2545_f491_4f6c_dd1du64);
     let mut files = Vec::new();
     for (k, (rank, child, depth)) in [(3, 0, 5), (3, 6, 5), (3, 2, 6), (4, 0, 4), (4, 5, 5)]
         .into_iter()

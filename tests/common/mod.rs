@@ -157,3 +157,14 @@ pub fn both_rtrace(oracle: &Oracle, dir: &Path, opts: &[&str], rays: &str) -> (V
     assert_eq!(t.len(), o.len());
     (t, o)
 }
+
+/// A xorshift64 generator of numbers in [0, 1) from `seed` (test data that is the same
+/// on every run and machine).
+pub fn xorshift(mut seed: u64) -> impl FnMut() -> f64 {
+    move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
