@@ -20,7 +20,9 @@ use crate::polygon::Polygon;
 use crate::rng::Rng;
 use crate::shape::Shape;
 
+mod cylinder;
 mod threshold;
+use cylinder::CylSource;
 pub use threshold::DirectState;
 use threshold::{ObsCache, SourceSample};
 
@@ -405,8 +407,26 @@ impl Tracer {
                         _ => true,
                     };
                 if active {
-                    if matches!(shapes[s], Shape::Cone { .. }) {
-                        bail!("{}: cone and cylinder light sources are not supported by fenestra's ray tracer", scene.prims[surf_prim[s]].loc);
+                    if let Shape::Cone { len, r0, .. } = shapes[s] {
+                        let p = &scene.prims[surf_prim[s]];
+                        if p.ptype != "cylinder" {
+                            // Radiance: "illegal material for cone" (also cup, tube)
+                            bail!(
+                                "{}: {} '{}' has the light-emitting material '{}': a light, illum, glow \
+                                 or spotlight source must be a sphere, polygon, ring, cylinder or \
+                                 source (Radiance stops with \"illegal material\" here too)",
+                                p.loc,
+                                p.ptype,
+                                p.name,
+                                scene.prims[m].name
+                            );
+                        }
+                        if r0 > 0.2 * len {
+                            warnings.push(format!(
+                                "{}: cylinder source '{}': aspect too small (radius above 0.2 x length)",
+                                p.loc, p.name
+                            ));
+                        }
                     }
                     sources.push(Source {
                         geom: SourceGeom::Local(s),
@@ -1468,7 +1488,7 @@ impl Tracer {
         }
         let skip = shape.filter(|&s| self.accel.shapes[s].is_flat());
         for si in 0..self.sources.len() {
-            self.each_sample(si, p, shape, cx, |cx, s| {
+            self.each_sample(si, p, shape, r.weight, cx, |cx, s| {
                 let ldot = s.l.dot(nrm);
                 self.shadow(
                     r,
@@ -1489,11 +1509,14 @@ impl Tracer {
     /// Calls `f` for every sample of source `si` seen from `p` (on surface `shape`): its
     /// unit direction, solid angle, shadow-ray length and the number of samples drawn
     /// for the source. Samples are drawn (random numbers used) before the first call.
+    /// `weight` is the weight of the ray that reached `p` (a cylinder's `-ds` subdivision
+    /// depends on it, as in Radiance).
     fn each_sample(
         &self,
         si: usize,
         p: DVec3,
         shape: Option<usize>,
+        weight: f64,
         cx: &mut Ctx,
         mut f: impl FnMut(&mut Ctx, SourceSample),
     ) {
@@ -1546,7 +1569,9 @@ impl Tracer {
                     } => (f64::INFINITY, *flen),
                     _ => (f64::INFINITY, 0.0),
                 };
-                let mut emit = |cx: &mut Ctx, q: DVec3, omega: f64, count: usize| {
+                // `beyond`: how far past the sample point its shadow ray may still meet the
+                // source (a cylinder's sample can lie off its surface)
+                let mut emit = |cx: &mut Ctx, q: DVec3, omega: f64, count: usize, beyond: f64| {
                     let v = q - p;
                     let dist = v.length();
                     if dist <= 0.0 || dist > maxrad || omega <= 0.0 {
@@ -1564,22 +1589,46 @@ impl Tracer {
                         SourceSample {
                             l: v / dist,
                             omega,
-                            tmax: dist * (1.0 + 1e-7) + Self::tmin(q),
+                            tmax: dist * (1.0 + 1e-7) + beyond + Self::tmin(q),
                             count,
                         },
                     );
                 };
+                if let Shape::Cone {
+                    p0, axis, len, r0, ..
+                } = self.accel.shapes[sh]
+                {
+                    let cyl = CylSource::new(p0, axis, len, r0);
+                    let parts = cyl.partitions(p, self.opts.ds, weight);
+                    let count = parts.len();
+                    let samples: Vec<(DVec3, f64)> = parts
+                        .into_iter()
+                        .filter_map(|(cent, size)| {
+                            let jit = if self.opts.dj > 0.0 {
+                                let u = [cx.rng.next_f64(), cx.rng.next_f64(), cx.rng.next_f64()];
+                                Some((self.opts.dj, u))
+                            } else {
+                                None
+                            };
+                            cyl.sample(p, cent, size, jit)
+                        })
+                        .collect();
+                    for (q, omega) in samples {
+                        emit(cx, q, omega, count, cyl.beyond());
+                    }
+                    return;
+                }
                 if let Shape::Sphere { c, r, .. } = &self.accel.shapes[sh] {
                     // one sample at the centre (as source_samples gives, without a Vec)
                     if let Some(omega) = Self::sphere_omega(*c, *r, p) {
-                        emit(cx, *c, omega, 1);
+                        emit(cx, *c, omega, 1, 0.0);
                     }
                     return;
                 }
                 let samples = self.source_samples(sh, p, cx);
                 let count = samples.len();
                 for (q, omega) in samples {
-                    emit(cx, q, omega, count);
+                    emit(cx, q, omega, count, 0.0);
                 }
             }
         }

@@ -371,8 +371,8 @@ impl Tracer {
     }
 
     /// The most source samples a point can get: one per sphere, distant or virtual
-    /// source; with `-ds > 0` up to [`MAX_DIVISIONS`]² per flat source (a point close
-    /// enough to it), else one.
+    /// source; with `-ds > 0` up to [`MAX_DIVISIONS`]² per flat source and 64 per
+    /// cylinder (a point close enough to it), else one.
     pub(super) fn most_samples(opts: &TraceOptions, sources: &[Source], shapes: &[Shape]) -> usize {
         sources
             .iter()
@@ -381,7 +381,7 @@ impl Tracer {
                     Shape::Polygon(_) | Shape::Ring { .. } if opts.ds > 0.0 => {
                         MAX_DIVISIONS * MAX_DIVISIONS
                     }
-                    Shape::Cone { .. } => 0,
+                    Shape::Cone { .. } if opts.ds > 0.0 => super::cylinder::MAX_PARTS,
                     _ => 1,
                 },
                 SourceGeom::Distant(_) | SourceGeom::Virtual { .. } => 1,
@@ -465,7 +465,12 @@ impl Tracer {
                                 reach: *r1,
                             }
                         }
-                        Shape::Cone { .. } => return None,
+                        // a cylinder's cache is a sphere's (cube of directions), cast
+                        // from 1.05 × half its length around its midpoint
+                        Shape::Cone { p0, axis, len, .. } => CacheGeom::Round {
+                            c: *p0 + *axis * (0.5 * len),
+                            r: 0.5 * len,
+                        },
                     },
                 };
                 let first = if si < MAX_PRECAST { UNCAST } else { 0 };
@@ -652,7 +657,7 @@ impl Tracer {
         let mut tail = std::mem::take(&mut st.tail);
         cands.clear();
         for si in 0..self.sources.len() {
-            self.each_sample(si, p, shape, cx, |cx, s| {
+            self.each_sample(si, p, shape, r.weight, cx, |cx, s| {
                 let single = s.count == 1;
                 let Some(st) = cx.ds.as_deref_mut() else {
                     return;
