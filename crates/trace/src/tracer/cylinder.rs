@@ -41,7 +41,12 @@ const ACROSS: f64 = 0.8559;
 
 impl CylSource {
     pub(super) fn new(p0: DVec3, axis: DVec3, len: f64, r: f64) -> CylSource {
-        let a = axis.any_orthonormal_vector();
+        // across the axis: Radiance's unrandomised choice (its -u-), the last coordinate
+        // axis with |component| < 0.6 crossed with the axis
+        let i = (0..3).rev().find(|&i| axis[i].abs() < 0.6).unwrap_or(0);
+        let mut e = DVec3::ZERO;
+        e[i] = 1.0;
+        let a = e.cross(axis).normalize();
         let w = a * (ACROSS * r);
         let v = w.cross(axis);
         CylSource {
