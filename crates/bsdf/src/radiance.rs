@@ -40,13 +40,21 @@
 //! its remainder's colour is quantised again with two more `drand48()` numbers, incident patch in
 //! the outer loop and outgoing patch in the inner one, unless the remainder's luminance is at
 //! most 1e-5 (no numbers drawn). On `coloured_xml(dir, true)` (tests/bsdf_xml.rs) every channel
-//! of every element agrees with the oracle within 5.4e-7. A remainder can be negative (an element
+//! of every element agrees with the oracle within 4.1e-7. A remainder can be negative (an element
 //! near the minimum with a position factor above 1): Radiance warns (`BTDF has 1 negatives`) and
 //! counts it as zero, and so do we (a constant coloured matrix with one lowered element: within
-//! 1.7e-7 of the oracle). The Sharp RGB → XYZ step (luminance and chromaticity of a remainder)
-//! multiplies and adds in single precision, as Radiance's float table and channels do: a
-//! remainder near the smallest position factor is a few float steps per channel, and in double
-//! one such element of a constant coloured matrix got another u′ code (1.5e-4 to 1.8e-3 off).
+//! 1.7e-7 of the oracle).
+//!
+//! Arithmetic of the oracle's build (read from its machine code; it is compiled with reordered
+//! floating point and approximate reciprocals), reproduced because a quantised chromaticity can
+//! sit on a code boundary: X + Y + Z in single precision and x, y = X, Y times [`fast_recip`] of
+//! it; Sharp RGB → XYZ products and sums in single precision (a remainder near the smallest
+//! position factor is a few float steps per channel: in double one element of a constant
+//! coloured matrix got another u′ code, 1.5e-4 to 1.8e-3 off); the weighted green and blue
+//! Sharp channels unweighted with [`fast_recip`], red with a division; decoding with
+//! `(6u′ + 12) − 16v′`, Sharp RGB with `1 − (x + y)`, the position factor with
+//! `(d − ½) − trunc(d)`. The Lambertian part's RGB is desaturated into the gamut like an
+//! element's (constant colours outside the gamut: tests/bsdf_xml.rs).
 
 use crate::klems::KlemsBasis;
 use crate::model::{Bsdf, Direction, KlemsMatrix, Wavelength};
@@ -208,6 +216,35 @@ pub(crate) const XYZ_FROM_SHARP_F: [[f32; 3]; 3] = [
     [-0.0123, 0.0167, 0.9955],
 ];
 
+/// `1/s` as the oracle's build of Radiance's BSDF library computes it (compiled with
+/// approximate reciprocals): the processor's `rcpss` estimate `r` refined by one Newton step
+/// `2r − s·r·r`, in single precision. On x86-64 this uses the processor's own estimate, as the
+/// oracle does on the same machine; elsewhere the exact quotient.
+pub(crate) fn fast_recip(s: f32) -> f32 {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_cvtss_f32, _mm_rcp_ss, _mm_set_ss};
+        // SAFETY: SSE is part of the x86-64 baseline, so these instructions always exist.
+        let r = unsafe { _mm_cvtss_f32(_mm_rcp_ss(_mm_set_ss(s))) };
+        (r + r) - (s * r) * r
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        1.0 / s
+    }
+}
+
+/// Sharp RGB channels divided by their primaries' luminance weights as the oracle's build does
+/// it: the red channel by a division, green and blue times [`fast_recip`] of the weight.
+fn unweight(c: [f32; 3]) -> [f32; 3] {
+    let w = XYZ_FROM_SHARP_F[1];
+    [
+        c[0] / w[0],
+        c[1] * fast_recip(w[1]),
+        c[2] * fast_recip(w[2]),
+    ]
+}
+
 /// Quantised (u′, v′) indices of a CIE (x, y) chromaticity (single precision, as Radiance
 /// keeps it) with two dither numbers, u′ first; indices truncated and clamped to 0…255.
 fn encode_xy(cx: f32, cy: f32, rng: &mut Drand48) -> (f64, f64) {
@@ -221,7 +258,8 @@ fn encode_xy(cx: f32, cy: f32, rng: &mut Drand48) -> (f64, f64) {
 /// CIE (x, y) (single precision) of quantised (u′, v′) indices, as Radiance decodes them.
 fn decode_xy((ub, vb): (f64, f64)) -> (f32, f32) {
     let (up, vp) = (ub * (1.0 / UV_STEPS), vb * (1.0 / UV_STEPS));
-    let df = 1.0 / (6.0 * up - 16.0 * vp + 12.0);
+    // (6u′ + 12) − 16v′: the order of the oracle's build
+    let df = 1.0 / ((6.0 * up + 12.0) - 16.0 * vp);
     ((9.0 * up * df) as f32, (4.0 * vp * df) as f32)
 }
 
@@ -230,7 +268,8 @@ pub(crate) fn to_sharp((cx, cy): (f32, f32), y: f64) -> [f32; 3] {
     let xyz = [
         f64::from(cx / cy) * y,
         y,
-        (1.0 - f64::from(cx) - f64::from(cy)) / f64::from(cy) * y,
+        // 1 − (x + y): the order of the oracle's build
+        (1.0 - (f64::from(cx) + f64::from(cy))) / f64::from(cy) * y,
     ];
     XYZ_TO_SHARP_F.map(|r| {
         (f64::from(r[0]) * xyz[0] + f64::from(r[1]) * xyz[1] + f64::from(r[2]) * xyz[2]) as f32
@@ -255,6 +294,9 @@ pub(crate) fn from_sharp(c: [f32; 3]) -> (f64, Option<(f32, f32)>) {
 /// Dithered (u′, v′) lattice indices of every element of a coloured component, indexed
 /// `o · n_in + i`: Radiance's chromaticity x/(X+Y+Z), y/(X+Y+Z) of the single-precision values
 /// (1/3, 1/3 for a zero element), elements from the last stored index down to the first.
+/// Single-precision sum and [`fast_recip`] as the oracle's build computes them: with a double
+/// sum and division, constant XYZ (0.1, 0.2, 0.3) gives u′ 40.9999989·… instead of 41.0000005
+/// and two elements get the u′ code 40 (found in the oracle's machine code).
 fn encode_chroma(
     y: &KlemsMatrix,
     x: &KlemsMatrix,
@@ -266,9 +308,12 @@ fn encode_chroma(
     for k in (0..ni * no).rev() {
         let (o, i) = (k / ni, k % ni);
         let [xv, yv, zv] = [x.get(o, i), y.get(o, i), z.get(o, i)].map(|v| v.max(0.0) as f32);
-        let sum = f64::from(xv + yv + zv);
+        // The oracle's build sums in single precision and divides by multiplying with the
+        // processor's approximate reciprocal after one Newton step ([`fast_recip`]).
+        let sum = xv + yv + zv;
         let (cx, cy) = if sum > 0.0 {
-            ((f64::from(xv) / sum) as f32, (f64::from(yv) / sum) as f32)
+            let r = fast_recip(sum);
+            (xv * r, yv * r)
         } else {
             ((1.0f64 / 3.0) as f32, (1.0f64 / 3.0) as f32)
         };
@@ -285,8 +330,9 @@ fn encode_chroma(
 pub(crate) fn jittered(m: &KlemsMatrix, o: usize, i: usize) -> f32 {
     let (ni, no) = (m.incident.len(), m.outgoing.len());
     let d = (2 * ni) as f64 / (i as f64 + 0.22545) + (4 * no) as f64 / (o as f64 + 0.70281);
-    let d = d - d.trunc();
-    (f64::from(m.get(o, i).max(0.0) as f32) * (1.0 + 6e-4 * (d - 0.5))) as f32
+    // The oracle's build computes the fraction minus ½ as (d − ½) − trunc(d).
+    let f = (d - 0.5) - d.trunc();
+    (f64::from(m.get(o, i).max(0.0) as f32) * (1.0 + 6e-4 * f)) as f32
 }
 
 /// A coloured component's Lambertian split, as Radiance does it: each element's value
@@ -328,7 +374,7 @@ fn split_colour(
         for o in 0..no {
             let k = o * ni + i;
             let c = coef(chroma, i, o);
-            let r = [0, 1, 2].map(|ch| (c[ch] - min[ch]) / w[ch]);
+            let r = unweight([0, 1, 2].map(|ch| c[ch] - min[ch]));
             if let (lum, Some((cx, cy))) = from_sharp(r) {
                 if lum > 1e-5 {
                     chroma[k] = encode_xy(cx, cy, rng);
@@ -337,7 +383,7 @@ fn split_colour(
             rest[k] = f64::from(y.values[k].max(0.0) as f32 - ymin);
         }
     }
-    let (_, lxy) = from_sharp([0, 1, 2].map(|ch| min[ch] / w[ch]));
+    let (_, lxy) = from_sharp(unweight(min));
     let (cx, cy) = lxy.map_or((1.0 / 3.0, 1.0 / 3.0), |(x, y)| {
         (f64::from(x), f64::from(y))
     });
@@ -350,7 +396,10 @@ fn split_colour(
 struct Colour {
     chroma: Vec<(f64, f64)>,
     remainder: Option<Vec<f64>>,
+    /// RGB of the Lambertian part, desaturated into the RGB gamut as Radiance converts it.
     lambertian: [f64; 3],
+    /// CIE XYZ of the Lambertian part.
+    lambertian_xyz: [f64; 3],
 }
 
 /// Colour value (RGB) of element (o, i) of a component: grey Y, or Y with the component's
@@ -464,14 +513,19 @@ fn encode_all<'a>(b: &'a Bsdf, rng: &mut Drand48) -> [Slot<'a>; 4] {
         let colour = match (x, z) {
             (Some(x), Some(z)) => {
                 let mut chroma = encode_chroma(y, x, z, rng);
-                let (remainder, lambertian) = match split_colour(y, &mut chroma, rng) {
-                    Some((rest, xyz)) => (Some(rest), mul3(&m, xyz)),
+                let (remainder, lambertian_xyz) = match split_colour(y, &mut chroma, rng) {
+                    Some((rest, xyz)) => (Some(rest), xyz),
                     None => (None, [0.0; 3]),
                 };
+                // Radiance turns the Lambertian part into RGB with the same gamut clipping as an
+                // element's colour (an out-of-gamut constant colour: channels near zero, not
+                // negative, in the oracle's matrix).
+                let lambertian = clip_gamut(mul3(&m, lambertian_xyz), lambertian_xyz[1]);
                 Some(Colour {
                     chroma,
                     remainder,
                     lambertian,
+                    lambertian_xyz,
                 })
             }
             _ => None,
@@ -511,7 +565,7 @@ pub fn colour_lambertians(b: &Bsdf, rng: &mut Drand48) -> Vec<(Direction, [f64; 
     for (d, slot) in ENCODE_ORDER.into_iter().zip(&slots) {
         let Slot::Klems(c) = slot else { continue };
         if let Some(col) = c.colour.as_ref().filter(|c| c.remainder.is_some()) {
-            out.push((d, mul3(&inv3(&c.m), col.lambertian)));
+            out.push((d, col.lambertian_xyz));
         }
     }
     out
