@@ -13,9 +13,7 @@ mod common;
 use std::process::Command;
 
 /// Tubes in several orientations, lengths and radii, near and far, each with its own
-/// material (Radiance lets a shadow ray aimed at one source be stopped by another source
-/// object, even of the same material; fenestra does not tell objects of one material
-/// apart there, so the tubes do not share one), and two blockers.
+/// material, and two blockers (sources sharing a material: tests/source_objects.rs).
 const SCENE: &str = "
 void light m1 0 0 3 10 10 10
 m1 cylinder t1 0 0 7 -1 0 2 1 0 2 0.05

@@ -914,8 +914,16 @@ impl Tracer {
                         return DVec3::ZERO;
                     }
                     let d = &self.distant[k];
-                    let (val, zeroed) =
-                        self.shade_light(r, d.mat, 1.0, f64::INFINITY, DVec3::ZERO, None, cx);
+                    let (val, zeroed) = self.shade_light(
+                        r,
+                        d.mat,
+                        d.prim,
+                        1.0,
+                        f64::INFINITY,
+                        DVec3::ZERO,
+                        None,
+                        cx,
+                    );
                     self.report(cx, r, d.prim, val, r.org, -r.dir, 1e10, zeroed);
                     return val;
                 }
@@ -936,7 +944,7 @@ impl Tracer {
                 let Some(k) = k else { return DVec3::ZERO };
                 let d = &self.distant[k];
                 let (val, zeroed) =
-                    self.shade_light(r, d.mat, 1.0, f64::INFINITY, DVec3::ZERO, None, cx);
+                    self.shade_light(r, d.mat, d.prim, 1.0, f64::INFINITY, DVec3::ZERO, None, cx);
                 self.report(cx, r, d.prim, val, r.org, -r.dir, 1e10, zeroed);
                 val
             }
@@ -990,7 +998,9 @@ impl Tracer {
     ) -> (DVec3, bool) {
         let rod = -r.dir.dot(n);
         match &self.mats[&m] {
-            Material::Light { .. } => self.shade_light(r, m, rod, t, p, Some(shape), cx),
+            Material::Light { .. } => {
+                self.shade_light(r, m, self.surf_prim[shape], rod, t, p, Some(shape), cx)
+            }
             Material::Glass { tn, n: idx } => (
                 self.shade_glass(r, *tn, *idx, shape, p, n, rod, t, cx),
                 false,
@@ -1113,6 +1123,7 @@ impl Tracer {
         &self,
         r: &Ray,
         m: usize,
+        prim: usize,
         rod: f64,
         t: f64,
         p: DVec3,
@@ -1127,9 +1138,31 @@ impl Tracer {
         {
             return (DVec3::ZERO, true);
         }
-        let own_source = r.src.is_none_or(|s| self.sources[s].mat == m);
-        if !own_source && !matches!(kind, LightKind::Illum(_)) {
-            return (DVec3::ZERO, true);
+        // A shadow ray is aimed at one source object: meeting another emitter, even one
+        // of the same material, it is stopped (as Radiance compares the object hit with
+        // the source's object), unless that emitter is an illum it may pass. An illum
+        // does not pass a ray aimed at another illum or glow when met from its front
+        // (that would count the light twice), except a ray relayed toward a virtual source.
+        let own_source = r.src.is_none_or(|s| self.sources[s].prim == prim);
+        if !own_source {
+            let blocked = match kind {
+                LightKind::Illum(_) => {
+                    let s = &self.sources[r.src.expect("aimed ray")];
+                    !matches!(s.geom, SourceGeom::Virtual { .. })
+                        && rod > 0.0
+                        && matches!(
+                            self.mats[&s.mat],
+                            Material::Light {
+                                kind: LightKind::Illum(_) | LightKind::Glow(_),
+                                ..
+                            }
+                        )
+                }
+                _ => true,
+            };
+            if blocked {
+                return (DVec3::ZERO, true);
+            }
         }
         if let LightKind::Illum(alt) = kind {
             // An illum is a source only for its own shadow rays; any other ray (a view

@@ -544,9 +544,10 @@ impl Tracer {
         }
     }
 
-    /// Whether shape `b` emits with source `si`'s material (not a blocker of that source).
+    /// Whether shape `b` is source `si`'s own surface (not a blocker of that source; any
+    /// other emitter is, even of the same material).
     fn own_emitter(&self, si: usize, b: usize) -> bool {
-        self.surf_mat[b] == self.sources[si].mat
+        self.surf_prim[b] == self.sources[si].prim
     }
 
     /// Records the surface that blocked a failed shadow test of source `si` in its cache.
@@ -581,7 +582,7 @@ impl Tracer {
         match s.geom {
             SourceGeom::Distant(k) => {
                 let d = &self.distant[k];
-                self.shade_light(c, d.mat, 1.0, f64::INFINITY, DVec3::ZERO, None, cx)
+                self.shade_light(c, d.mat, d.prim, 1.0, f64::INFINITY, DVec3::ZERO, None, cx)
                     .0
             }
             SourceGeom::Local(sh) => {
@@ -604,7 +605,8 @@ impl Tracer {
                     Some(t) => {
                         let q = c.org + c.dir * t;
                         let rod = -c.dir.dot(shp.normal(q));
-                        self.shade_light(c, s.mat, rod, t, q, Some(sh), cx).0
+                        self.shade_light(c, s.mat, s.prim, rod, t, q, Some(sh), cx)
+                            .0
                     }
                     None => DVec3::ZERO,
                 }
@@ -631,7 +633,16 @@ impl Tracer {
                 rc.org = q;
                 rc.dir = (c.dir + nrm * (2.0 * rod.abs())).normalize();
                 rc.src = Some(base);
-                let v = self.shade_light(&rc, d.mat, 1.0, f64::INFINITY, DVec3::ZERO, None, cx);
+                let v = self.shade_light(
+                    &rc,
+                    d.mat,
+                    d.prim,
+                    1.0,
+                    f64::INFINITY,
+                    DVec3::ZERO,
+                    None,
+                    cx,
+                );
                 *color * v.0
             }
         }
