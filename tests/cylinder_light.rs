@@ -2,9 +2,8 @@
 //! `cylinder`, against the reference rtrace and rcontrib, and the error for a light on a
 //! cone, cup or tube (Radiance: "illegal material").
 //!
-//! The deterministic comparisons trace view rays that hit the floor or a wall (not `-I`:
-//! Radiance evaluates `-I` irradiance 1e-4 along the normal from the given point, fenestra
-//! at the point, for every kind of source) and at most 32 records per run (with `-dt > 0`
+//! The deterministic comparisons trace view rays that hit the floor or a wall (`-I` near a
+//! tube: tests/irradiance_point.rs) and at most 32 records per run (with `-dt > 0`
 //! fenestra carries the hit statistics and obstructor caches exactly as Radiance does for
 //! the first 32 records, then in parallel blocks; see docs/tools/rtrace.md).
 

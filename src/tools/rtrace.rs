@@ -255,7 +255,10 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                         let v = if dir == DVec3::ZERO {
                             [0.0; 3]
                         } else if irr {
-                            tracer.irradiance_with(st, k as u64, org, dir)
+                            // Radiance's -I point: 1e-4 along the normal
+                            let n = dir.normalize_or_zero();
+                            let q = Tracer::rtrace_irradiance_point(org, n);
+                            tracer.irradiance_with(st, k as u64, q, n)
                         } else if irr_hit {
                             tracer.irradiance_at_hit_with(st, k as u64, org, dir)
                         } else {

@@ -334,8 +334,11 @@ impl<'a> Engine<'a> {
                 }
             }
         } else if self.opts.irradiance {
+            // Radiance's rcontrib -I point: 1e-4 along the normal
+            let n = ray.dir.normalize_or_zero();
+            let q = Tracer::rcontrib_irradiance_point(ray.org, n);
             self.tracer
-                .contributions_irradiance(index, ray.org, ray.dir, &self.tracked, &mut sink);
+                .contributions_irradiance(index, q, n, &self.tracked, &mut sink);
         } else {
             // -ld+: the ray ends at the length of its direction vector
             let len = if self.opts.limit_dist {

@@ -658,7 +658,8 @@ impl Tracer {
         v.to_array()
     }
 
-    /// Irradiance at `point` on a surface facing `normal` (rtrace `-I`).
+    /// Irradiance at `point` itself on a surface facing `normal` (rtrace `-I` evaluates
+    /// it at [`Self::rtrace_irradiance_point`] of the input point).
     pub fn irradiance(&self, ray_index: u64, point: DVec3, normal: DVec3) -> [f64; 3] {
         self.irradiance_with(&mut self.direct_state(), ray_index, point, normal)
     }
@@ -764,13 +765,37 @@ impl Tracer {
             .fetch_add(cx.rays, std::sync::atomic::Ordering::Relaxed);
     }
 
+    /// Where Radiance's rtrace `-I` evaluates the irradiance for an input `point` and
+    /// unit `normal`: its fake ray starts 1.1e-4 along the normal and "hits" 1e-5 back
+    /// toward the point, i.e. 1e-4 along the normal (computed in those two steps, as
+    /// rtrace does, so that the rounding is the same).
+    pub fn rtrace_irradiance_point(point: DVec3, normal: DVec3) -> DVec3 {
+        (point + normal * 1.1e-4) + (-normal) * 1e-5
+    }
+
+    /// Where Radiance's rcontrib `-I` evaluates the irradiance: 1e-4 along the unit
+    /// `normal` from `point`, in one step.
+    pub fn rcontrib_irradiance_point(point: DVec3, normal: DVec3) -> DVec3 {
+        point + normal * 1e-4
+    }
+
+    /// `-I` at `p` itself (the tools move it off the surface first, see
+    /// [`Self::rtrace_irradiance_point`]).
     fn irradiance_in(&self, p: DVec3, n: DVec3, cx: &mut Ctx) -> DVec3 {
         // Radiance's -I: a Lambertian of reflectance pi at the point, seen along -n.
         let r = Ray {
-            org: p + n * 1.1e-4,
+            org: p + n * 1e-5,
             dir: -n,
             ..Self::primary(p, -n)
         };
+        self.lambert(&r, p, n, None, cx)
+    }
+
+    /// Irradiance at `p` on a surface facing unit `n` (Radiance's irradiance hack: a
+    /// Lambertian of reflectance pi there, patterns ignored), reached by ray `r` (its clip
+    /// set and weight carry over to the shadow and ambient rays); `shape` is the surface
+    /// hit, if any.
+    fn lambert(&self, r: &Ray, p: DVec3, n: DVec3, shape: Option<usize>, cx: &mut Ctx) -> DVec3 {
         let rho = DVec3::splat(PI);
         let lamb = |_l: DVec3, omega: f64, ldot: f64| {
             if ldot > 0.0 {
@@ -782,11 +807,11 @@ impl Tracer {
         if cx.ds.is_some() {
             // thresholding: direct light last, as Radiance (its threshold is relative
             // to what the surface already returns)
-            let amb = self.ambient(&r, p, n, rho, None, cx);
-            return amb + self.direct(&r, p, n, None, amb, cx, lamb);
+            let amb = self.ambient(r, p, n, rho, shape, cx);
+            return amb + self.direct(r, p, n, shape, amb, cx, lamb);
         }
-        let mut val = self.direct(&r, p, n, None, DVec3::ZERO, cx, lamb);
-        val += self.ambient(&r, p, n, rho, None, cx);
+        let mut val = self.direct(r, p, n, shape, DVec3::ZERO, cx, lamb);
+        val += self.ambient(r, p, n, rho, shape, cx);
         val
     }
 
