@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use fenestra_contrib::calc::{is_zero_constant, parse_params, BinRequest, Bins, CalcDefs};
 use fenestra_contrib::engine::{
-    read_rays, Engine, HitKind, InFormat, InputRay, Record, RunOptions, Tracked,
+    read_rays, Engine, InFormat, InputRay, Record, RunOptions, Tracked,
 };
 use fenestra_contrib::output::{self, Format, HeaderInfo, ModOut, Spec, Stream};
 use fenestra_trace::{TraceOptions, Tracer};
@@ -393,25 +393,6 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     if irr && irr_hit {
         bail!("options -I and -i are mutually exclusive");
     }
-    // -i: which surfaces a ray passes (glass, illum), which emit, which stop it
-    let hit_kinds = irr_hit.then(|| {
-        scene
-            .prims
-            .iter()
-            .map(|p| {
-                let t = p
-                    .modifier
-                    .map(|m| scene.prims[m].ptype.as_str())
-                    .unwrap_or("");
-                match t {
-                    "glass" | "illum" => HitKind::Pass,
-                    "light" | "glow" | "spotlight" => HitKind::Light,
-                    _ => HitKind::Opaque,
-                }
-            })
-            .collect()
-    });
-
     // -ld+ (not with -I, which ignores the length as Radiance does)
     let limit = limit_dist && !irr;
 
@@ -430,7 +411,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     // modifier reaches (rays are seeded by index, so the second pass meets the same ones)
     if dynamic {
         let probe_opts = RunOptions {
-            irradiance_at_hit: hit_kinds.clone(),
+            irradiance_at_hit: irr_hit,
             limit_dist: limit,
             irradiance: irr,
             value,
@@ -580,7 +561,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         .collect::<Result<_>>()?;
 
     let opts = RunOptions {
-        irradiance_at_hit: hit_kinds,
+        irradiance_at_hit: irr_hit,
         limit_dist: limit,
         irradiance: irr,
         value,

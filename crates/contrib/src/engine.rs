@@ -109,25 +109,14 @@ pub struct Tracked {
     pub nbins: usize,
 }
 
-/// What a surface does to an `-i` ray looking for the first opaque surface.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum HitKind {
-    /// Passed straight through (glass, illum).
-    Pass,
-    /// An emitter: the ray takes its radiance.
-    Light,
-    /// Opaque: irradiance is computed there.
-    Opaque,
-}
-
 /// Settings of a run.
 #[derive(Debug, Clone)]
 pub struct RunOptions {
     /// `-I`: the input direction is a surface normal (irradiance).
     pub irradiance: bool,
-    /// `-i`: irradiance at the first opaque surface along each ray; the kind of every
-    /// scene primitive (indexed like the scene).
-    pub irradiance_at_hit: Option<Vec<HitKind>>,
+    /// `-i`: irradiance at the first surface along each ray that is not passed
+    /// ([`Tracer::irradiance_at_hit`]).
+    pub irradiance_at_hit: bool,
     /// `-V`: contributions (coefficient × radiance) instead of coefficients.
     pub value: bool,
     /// `-c`: rays per record (0: one summed record).
@@ -292,47 +281,22 @@ impl<'a> Engine<'a> {
             acc[s + 1] += v[1];
             acc[s + 2] += v[2];
         };
-        if let Some(kinds) = &self.opts.irradiance_at_hit {
-            let d = ray.dir.normalize();
-            let mut o = ray.org;
-            // -ld+: what is left of the ray's length (passing surfaces does not reset it)
-            let mut left = if self.opts.limit_dist {
+        if self.opts.irradiance_at_hit {
+            // -ld+: the ray ends at the length of its direction vector (surfaces passed on
+            // the way do not reset it)
+            let len = if self.opts.limit_dist {
                 ray.dir.length()
             } else {
                 f64::INFINITY
             };
-            for _ in 0..100 {
-                let h = self.tracer.first_hit(o, d);
-                if left.is_finite() {
-                    if h.prim.is_none() || h.t >= left {
-                        return;
-                    }
-                    left -= h.t;
-                }
-                match h
-                    .prim
-                    .map(|p| kinds.get(p).copied().unwrap_or(HitKind::Opaque))
-                {
-                    Some(HitKind::Pass) => {
-                        o = h.point + d * (1e-7 * (1.0 + h.point.abs().max_element()));
-                    }
-                    Some(HitKind::Opaque) => {
-                        self.tracer.contributions_irradiance(
-                            index,
-                            h.point,
-                            h.normal,
-                            &self.tracked,
-                            &mut sink,
-                        );
-                        return;
-                    }
-                    None | Some(HitKind::Light) => {
-                        self.tracer
-                            .contributions(index, o, d, &self.tracked, &mut sink);
-                        return;
-                    }
-                }
-            }
+            self.tracer.contributions_irradiance_at_hit(
+                index,
+                ray.org,
+                ray.dir,
+                len,
+                &self.tracked,
+                &mut sink,
+            );
         } else if self.opts.irradiance {
             // Radiance's rcontrib -I point: 1e-4 along the normal
             let n = ray.dir.normalize_or_zero();

@@ -31,6 +31,9 @@ const REFLECTED: u8 = 2;
 const TRANS: u8 = 4;
 const AMBIENT: u8 = 8;
 const SPECULAR: u8 = 16;
+/// rtrace/rcontrib `-i`: while a ray has only this flag (and TRANS), the first surface that
+/// shades it gives the irradiance there (Radiance's irradiance hack).
+const IRRAD: u8 = 32;
 /// Most subdivisions per side of a flat source's samples (`-ds`).
 const MAX_DIVISIONS: usize = 16;
 
@@ -190,6 +193,9 @@ pub struct Tracer {
     obs: Option<Vec<Option<ObsCache>>>,
     /// Per BVH shape: a reliable shadow-ray blocker (opaque material, never clipped).
     blocker: Vec<bool>,
+    /// Per scene primitive: a material `-i` passes straight through (Radiance's nominally
+    /// transparent types and BSDF proxies), rather than taking the irradiance on it.
+    irr_pass: Vec<bool>,
 }
 
 fn maxc(c: DVec3) -> f64 {
@@ -557,6 +563,17 @@ impl Tracer {
             .collect();
         // Radiance's opaque material types (a shadow ray meeting one stops there; a
         // light or spotlight stops shadow rays aimed at other sources)
+        let irr_pass = scene
+            .prims
+            .iter()
+            .map(|p| match p.ptype.as_str() {
+                "trans" | "trans2" | "dielectric" | "interface" | "mist" | "glass" | "aBSDF" => {
+                    true
+                }
+                "BSDF" => p.sargs.first().is_some_and(|t| t != "0"),
+                _ => false,
+            })
+            .collect();
         let blocker = surf_mat
             .iter()
             .map(|m| {
@@ -587,6 +604,7 @@ impl Tracer {
             rays: std::sync::atomic::AtomicU64::new(0),
             obs: None,
             blocker,
+            irr_pass,
         };
         if threshold {
             tracer.obs = Some(tracer.build_caches());
@@ -1022,6 +1040,21 @@ impl Tracer {
         cx: &mut Ctx,
     ) -> (DVec3, bool) {
         let rod = -r.dir.dot(n);
+        if r.flags & IRRAD != 0 && r.flags & !(IRRAD | TRANS) == 0 {
+            // -i: emitters and antimatter act as usual (an illum passes the ray on to its
+            // alternate material, antimatter shades with its first modifier where a ray
+            // leaves it inside that modifier's volume, coming back here)
+            if !matches!(
+                self.mats[&m],
+                Material::Light { .. } | Material::Antimatter { .. }
+            ) {
+                if self.irr_pass[m] {
+                    return (self.pass(r.clone(), shape, p, t, cx), false);
+                }
+                let nf = if rod < 0.0 { -n } else { n };
+                return (self.lambert(r, p, nf, Some(shape), cx), false);
+            }
+        }
         match &self.mats[&m] {
             Material::Light { .. } => {
                 self.shade_light(r, m, self.surf_prim[shape], rod, t, p, Some(shape), cx)
@@ -2142,8 +2175,12 @@ impl Tracer {
         }
     }
 
-    /// Irradiance at the first opaque surface along a ray (rtrace `-i`): glass, illum and
-    /// straight-transmitting surfaces are passed; an emitter or the sky gives its radiance.
+    /// Irradiance at the first surface along a ray that is not passed (rtrace `-i`), as
+    /// Radiance's irradiance hack: the ray is traced as usual (antimatter clip sets
+    /// included) and passes straight through trans, trans2, dielectric, interface, mist,
+    /// glass and aBSDF surfaces and BSDF proxies; an emitter or the sky gives its radiance
+    /// (an illum passes it on to its alternate material); any other surface gives the
+    /// irradiance there, on its side facing the ray, with a Lambertian of reflectance π.
     pub fn irradiance_at_hit(&self, ray_index: u64, org: DVec3, dir: DVec3) -> [f64; 3] {
         self.irradiance_at_hit_with(&mut self.direct_state(), ray_index, org, dir)
     }
@@ -2161,33 +2198,53 @@ impl Tracer {
         if d == DVec3::ZERO {
             return [0.0; 3];
         }
-        let mut o = org;
-        let mut skip = None;
-        for _ in 0..100 {
-            let Some(h) = self.accel.closest(o, d, Self::tmin(o), f64::INFINITY, skip) else {
-                return self.radiance_with(st, ray_index, o, d);
-            };
-            let p = o + d * h.t;
-            let mut n = self.accel.shapes[h.shape].normal(p);
-            match &self.mats[&self.surf_mat[h.shape]] {
-                Material::Glass { .. }
-                | Material::Light {
-                    kind: LightKind::Illum(_),
-                    ..
-                } => {
-                    o = p;
-                    skip = self.accel.shapes[h.shape].is_flat().then_some(h.shape);
-                }
-                Material::Light { .. } => return self.radiance_with(st, ray_index, o, d),
-                _ => {
-                    if n.dot(d) > 0.0 {
-                        n = -n;
-                    }
-                    return self.irradiance_with(st, ray_index, p, n);
-                }
-            }
+        let mut cx = Ctx {
+            rng: Rng::for_ray(self.opts.seed, ray_index),
+            rays: 0,
+            tracked: &[],
+            sink: None,
+            ds: self.state_for(st),
+        };
+        let r = Ray {
+            flags: IRRAD,
+            ..Self::primary(org, d)
+        };
+        let v = self.trace(&r, &mut cx);
+        self.count(&cx);
+        v.to_array()
+    }
+
+    /// As [`contributions_limited`](Self::contributions_limited) for rcontrib `-i`: the
+    /// ray as in [`irradiance_at_hit`](Self::irradiance_at_hit), ending after `len`
+    /// (`f64::INFINITY` without `-ld+`).
+    pub fn contributions_irradiance_at_hit(
+        &self,
+        ray_index: u64,
+        org: DVec3,
+        dir: DVec3,
+        len: f64,
+        tracked: &[bool],
+        sink: &mut impl FnMut(Contribution),
+    ) -> [f64; 3] {
+        let d = dir.normalize_or_zero();
+        if d == DVec3::ZERO || len.is_nan() || len <= 0.0 {
+            return [0.0; 3];
         }
-        [0.0; 3]
+        let mut cx = Ctx {
+            rng: Rng::for_ray(self.opts.seed, ray_index),
+            rays: 0,
+            tracked,
+            sink: Some(sink),
+            ds: None,
+        };
+        let r = Ray {
+            tmax: len,
+            flags: IRRAD,
+            ..Self::primary(org, d)
+        };
+        let v = self.trace(&r, &mut cx);
+        self.count(&cx);
+        v.to_array()
     }
 }
 
