@@ -996,10 +996,13 @@ impl Tracer {
                 let n = self.accel.shapes[h.shape].normal(p);
                 let m = self.surf_mat[h.shape];
                 if r.clip.contains(m) {
-                    // inside antimatter: this surface is not there
+                    // inside antimatter: this surface is not there (rcontrib still hears of
+                    // it, with what came through, as from Radiance)
                     let mut c = r.clone();
                     c.clip.cross(m, r.dir.dot(n) < 0.0);
-                    return self.pass(c, h.shape, p, h.t, cx);
+                    let val = self.pass(c, h.shape, p, h.t, cx);
+                    self.report(cx, r, self.surf_prim[h.shape], val, p, n, h.t, false);
+                    return val;
                 }
                 let (val, zeroed) = self.shade(r, m, h.shape, p, n, h.t, cx);
                 self.report(cx, r, self.surf_prim[h.shape], val, p, n, h.t, zeroed);
@@ -1068,9 +1071,9 @@ impl Tracer {
                 false,
             ),
             Material::Bsdf(b) => (self.shade_bsdf(r, b, shape, p, n, t, cx), false),
-            // Not reported to rcontrib: the surface itself is invisible.
+            // Reported to rcontrib with the value of the ray that met it, as by Radiance.
             Material::Antimatter { mods, first } => {
-                (self.antimatter(r, mods, *first, shape, p, n, t, cx), true)
+                (self.antimatter(r, mods, *first, shape, p, n, t, cx), false)
             }
             Material::Mirror { color } => {
                 if r.flags & SHADOW != 0 {
