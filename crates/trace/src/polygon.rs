@@ -195,6 +195,12 @@ impl Polygon {
         self.contains(q).then_some(t)
     }
 
+    /// Whether `p` (taken onto the polygon's plane) lies inside it or on its edge.
+    pub fn contains_point(&self, p: DVec3) -> bool {
+        let d = (p - self.origin).to_array();
+        self.contains(DVec2::new(d[self.axes.0], d[self.axes.1]))
+    }
+
     fn contains(&self, q: DVec2) -> bool {
         if q.x < self.lo.x || q.y < self.lo.y || q.x > self.hi.x || q.y > self.hi.y {
             return false;

@@ -21,8 +21,10 @@ use crate::rng::Rng;
 use crate::shape::Shape;
 
 mod cylinder;
+mod flat;
 mod threshold;
 use cylinder::CylSource;
+use flat::FlatSource;
 pub use threshold::DirectState;
 use threshold::{ObsCache, SourceSample};
 
@@ -34,8 +36,6 @@ const SPECULAR: u8 = 16;
 /// rtrace/rcontrib `-i`: while a ray has only this flag (and TRANS), the first surface that
 /// shades it gives the irradiance there (Radiance's irradiance hack).
 const IRRAD: u8 = 32;
-/// Most subdivisions per side of a flat source's samples (`-ds`).
-const MAX_DIVISIONS: usize = 16;
 
 /// One recorded contribution: a ray that reached a surface (or distant source) whose
 /// direct modifier is tracked.
@@ -144,6 +144,8 @@ struct Source {
     mat: usize,
     /// Scene index of the surface.
     prim: usize,
+    /// A polygon or ring source's sampling geometry.
+    flat: Option<FlatSource>,
 }
 
 #[derive(Debug, Clone)]
@@ -434,10 +436,48 @@ impl Tracer {
                             ));
                         }
                     }
+                    // Radiance: "cannot hit source center" (a polygon whose vertex mean
+                    // lies outside it, a ring with an inner radius)
+                    let p = &scene.prims[surf_prim[s]];
+                    let flat = match &shapes[s] {
+                        Shape::Polygon(poly) => match FlatSource::polygon(poly) {
+                            Ok((f, poor)) => {
+                                if poor {
+                                    warnings.push(format!(
+                                        "{}: polygon source '{}': triangular source with poor aspect",
+                                        p.loc, p.name
+                                    ));
+                                }
+                                Some(f)
+                            }
+                            Err(why) => bail!(
+                                "{}: polygon '{}' with the light-emitting material '{}': {why} \
+                                 (Radiance stops here too)",
+                                p.loc,
+                                p.name,
+                                scene.prims[m].name
+                            ),
+                        },
+                        Shape::Ring { c, n, r0, r1 } => {
+                            if *r0 > 0.0 {
+                                bail!(
+                                    "{}: ring '{}' with the light-emitting material '{}': cannot hit \
+                                     source center (a ring source must have inner radius 0; Radiance \
+                                     stops here too)",
+                                    p.loc,
+                                    p.name,
+                                    scene.prims[m].name
+                                );
+                            }
+                            Some(FlatSource::disk(*c, *n, *r1))
+                        }
+                        _ => None,
+                    };
                     sources.push(Source {
                         geom: SourceGeom::Local(s),
                         mat: m,
                         prim: surf_prim[s],
+                        flat,
                     });
                 }
             }
@@ -449,6 +489,7 @@ impl Tracer {
                         geom: SourceGeom::Distant(k),
                         mat: d.mat,
                         prim: d.prim,
+                        flat: None,
                     });
                 }
             }
@@ -473,6 +514,7 @@ impl Tracer {
                             },
                             mat: sources[b].mat,
                             prim: sources[b].prim,
+                            flat: None,
                         });
                     }
                 }
@@ -1712,17 +1754,30 @@ impl Tracer {
                     }
                     return;
                 }
-                if let Shape::Sphere { c, r, .. } = &self.accel.shapes[sh] {
-                    // one sample at the centre (as source_samples gives, without a Vec)
-                    if let Some(omega) = Self::sphere_omega(*c, *r, p) {
-                        emit(cx, *c, omega, 1, 0.0);
+                if let Some(flat) = &s.flat {
+                    let parts = flat.partitions(p, self.opts.ds, weight);
+                    let count = parts.len();
+                    let samples: Vec<(DVec3, f64)> = parts
+                        .into_iter()
+                        .filter_map(|part| {
+                            let jit = if self.opts.dj > 0.0 {
+                                let u = [cx.rng.next_f64(), cx.rng.next_f64()];
+                                Some((self.opts.dj, u))
+                            } else {
+                                None
+                            };
+                            flat.sample(p, part, count, jit)
+                        })
+                        .collect();
+                    for (q, omega) in samples {
+                        emit(cx, q, omega, count, 0.0);
                     }
                     return;
                 }
-                let samples = self.source_samples(sh, p, cx);
-                let count = samples.len();
-                for (q, omega) in samples {
-                    emit(cx, q, omega, count, 0.0);
+                if let Shape::Sphere { c, r, .. } = &self.accel.shapes[sh] {
+                    if let Some(omega) = Self::sphere_omega(*c, *r, p) {
+                        emit(cx, *c, omega, 1, 0.0);
+                    }
                 }
             }
         }
@@ -1791,9 +1846,9 @@ impl Tracer {
         val: &mut DVec3,
         cx: &mut Ctx,
     ) {
-        // (thresholding keeps samples down to maxc(coef) > 0 instead, see
-        // `direct_threshold`; each as it was, so neither output changes)
-        if maxc(coef) <= FTINY {
+        // as Radiance's direct(): any sample with a positive coefficient is tested (a
+        // grazing part of a subdivided source can have a coefficient below 1e-6)
+        if maxc(coef) <= 0.0 {
             return;
         }
         let c = self.shadow_ray(r, p, l, tmax, si, skip, coef);
@@ -1829,92 +1884,6 @@ impl Tracer {
             return None;
         }
         Some(2.0 * PI * (1.0 - (1.0 - r * r / d2).max(0.0).sqrt()))
-    }
-
-    /// Sample points on a local source seen from `p`, with the solid angle each stands for.
-    fn source_samples(&self, sh: usize, p: DVec3, cx: &mut Ctx) -> Vec<(DVec3, f64)> {
-        let shape = &self.accel.shapes[sh];
-        let dj = self.opts.dj;
-        let jit = |cx: &mut Ctx| {
-            if dj > 0.0 {
-                0.5 + dj * (cx.rng.next_f64() - 0.5)
-            } else {
-                0.5
-            }
-        };
-        match shape {
-            Shape::Sphere { c, r, .. } => Self::sphere_omega(*c, *r, p)
-                .map(|omega| vec![(*c, omega)])
-                .unwrap_or_default(),
-            Shape::Ring { c, n, r0, r1 } => {
-                let size = 2.0 * r1;
-                let k = self.divisions(size, (*c - p).length());
-                let (a, b) = frame(*n);
-                let mut out = Vec::new();
-                let area = PI * (r1 * r1 - r0 * r0);
-                let nn = (k * k) as f64;
-                for i in 0..k {
-                    for j in 0..k {
-                        let u = (i as f64 + jit(cx)) / k as f64;
-                        let v = (j as f64 + jit(cx)) / k as f64;
-                        let rad = (r0 * r0 + u * (r1 * r1 - r0 * r0)).sqrt();
-                        let ph = 2.0 * PI * v;
-                        let q = *c + a * (rad * ph.cos()) + b * (rad * ph.sin());
-                        let w = q - p;
-                        let d2 = w.length_squared();
-                        let cs = (w.dot(*n) / d2.sqrt()).abs();
-                        out.push((q, area * cs / (nn * d2)));
-                    }
-                }
-                out
-            }
-            Shape::Polygon(poly) => {
-                let cen = poly.centroid();
-                let dist = (cen - p).length();
-                let size = poly.area.sqrt();
-                let k = self.divisions(size, dist);
-                let nn = k * k;
-                // fan triangles from the first vertex, area-weighted
-                let v = &poly.verts;
-                let mut cum = Vec::with_capacity(v.len());
-                let mut tot = 0.0;
-                for i in 1..v.len() - 1 {
-                    tot += 0.5 * (v[i] - v[0]).cross(v[i + 1] - v[0]).dot(poly.normal).abs();
-                    cum.push(tot);
-                }
-                let mut out = Vec::with_capacity(nn);
-                for i in 0..k {
-                    for j in 0..k {
-                        let q = if nn == 1 && dj == 0.0 {
-                            cen
-                        } else {
-                            let u = (i as f64 + jit(cx)) / k as f64;
-                            let w = (j as f64 + jit(cx)) / k as f64;
-                            let x = u * tot;
-                            let ti = cum.iter().position(|&c| x <= c).unwrap_or(cum.len() - 1);
-                            let lo = if ti == 0 { 0.0 } else { cum[ti - 1] };
-                            let f = ((x - lo) / (cum[ti] - lo).max(1e-300)).clamp(0.0, 1.0);
-                            let su = f.sqrt();
-                            let (b0, b1) = (1.0 - su, su * (1.0 - w));
-                            v[0] * b0 + v[ti + 1] * b1 + v[ti + 2] * (1.0 - b0 - b1)
-                        };
-                        let wv = q - p;
-                        let d2 = wv.length_squared();
-                        let cs = (wv.dot(poly.normal) / d2.sqrt()).abs();
-                        out.push((q, poly.area * cs / (nn as f64 * d2)));
-                    }
-                }
-                out
-            }
-            Shape::Cone { .. } => vec![],
-        }
-    }
-
-    fn divisions(&self, size: f64, dist: f64) -> usize {
-        if self.opts.ds <= 0.0 || dist <= 0.0 {
-            return 1;
-        }
-        ((size / dist / self.opts.ds).ceil() as usize).clamp(1, MAX_DIVISIONS)
     }
 
     /// Indirect diffuse light by stratified cosine-weighted hemisphere sampling (`-aa 0`),

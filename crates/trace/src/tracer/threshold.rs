@@ -371,7 +371,7 @@ impl Tracer {
     }
 
     /// The most source samples a point can get: one per sphere, distant or virtual
-    /// source; with `-ds > 0` up to [`MAX_DIVISIONS`]² per flat source and 64 per
+    /// source; with `-ds > 0` up to 64 per flat source (polygon, ring) and 64 per
     /// cylinder (a point close enough to it), else one.
     pub(super) fn most_samples(opts: &TraceOptions, sources: &[Source], shapes: &[Shape]) -> usize {
         sources
@@ -379,7 +379,7 @@ impl Tracer {
             .map(|s| match s.geom {
                 SourceGeom::Local(sh) => match shapes[sh] {
                     Shape::Polygon(_) | Shape::Ring { .. } if opts.ds > 0.0 => {
-                        MAX_DIVISIONS * MAX_DIVISIONS
+                        super::flat::MAX_PARTS
                     }
                     Shape::Cone { .. } if opts.ds > 0.0 => super::cylinder::MAX_PARTS,
                     _ => 1,
