@@ -1694,16 +1694,16 @@ impl Tracer {
                 if Some(sh) == shape {
                     return;
                 }
-                let (maxrad, focus) = match &self.mats[&s.mat] {
+                let (maxrad, focus, spot) = match &self.mats[&s.mat] {
                     Material::Light {
                         kind: LightKind::Glow(rad),
                         ..
-                    } => (*rad, 0.0),
+                    } => (*rad, 0.0, None),
                     Material::Light {
-                        kind: LightKind::Spot(_, _, flen),
+                        kind: LightKind::Spot(cosang, aim, flen),
                         ..
-                    } => (f64::INFINITY, *flen),
-                    _ => (f64::INFINITY, 0.0),
+                    } => (f64::INFINITY, *flen, Some((*cosang, *aim))),
+                    _ => (f64::INFINITY, 0.0, None),
                 };
                 // `beyond`: how far past the sample point its shadow ray may still meet the
                 // source (a cylinder's sample can lie off its surface)
@@ -1712,6 +1712,13 @@ impl Tracer {
                     let dist = v.length();
                     if dist <= 0.0 || dist > maxrad || omega <= 0.0 {
                         return;
+                    }
+                    // a sample outside a spotlight's cone is dropped before any shadow ray
+                    // (as Radiance's srcray; rcontrib would otherwise record the ray)
+                    if let Some((cosang, aim)) = spot {
+                        if -(v / dist).dot(aim) < cosang {
+                            return;
+                        }
                     }
                     // a spotlight's light comes from its focus, `focus` behind the source
                     // (Radiance scales the sample's solid angle so)

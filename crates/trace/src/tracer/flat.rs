@@ -29,8 +29,12 @@ use crate::polygon::Polygon;
 /// Most parts of a flat source under `-ds` (Radiance's MAXSPART).
 pub(super) const MAX_PARTS: usize = 64;
 
-/// 2/√π: maps the square of a ring (side √π × radius) onto its disk.
-const SQUARE_TO_DISK: f64 = std::f64::consts::FRAC_2_SQRT_PI;
+/// 2/√π to 9 digits, as Radiance writes it (3e-9 above the exact value, so a corner of
+/// the square lands just past the rim): maps the square of a ring (side √π × radius)
+/// onto its disk. With the exact value a disk lamp's worst point was 1.3e-6 off Radiance,
+/// with this one 8.3e-7.
+#[allow(clippy::approx_constant)]
+const SQUARE_TO_DISK: f64 = 1.128_379_17;
 
 /// One part of a flat source: centre and size along `su` and `sv`, in 1/64ths of the
 /// half-extent (the whole source: centre 0, size 64).
@@ -317,7 +321,7 @@ mod tests {
         for part in &parts {
             for u in [[0.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.5, 0.5]] {
                 if let Some((q, _)) = r.sample(p, *part, parts.len(), Some((1.0, u))) {
-                    assert!(q.length() <= 0.5 + 1e-9, "{q}");
+                    assert!(q.length() <= 0.5 * (1.0 + 1e-8), "{q}");
                 }
             }
         }
