@@ -469,7 +469,11 @@ impl Tracer {
                                     scene.prims[m].name
                                 );
                             }
-                            Some(FlatSource::disk(*c, *n, *r1))
+                            // the normal as written (Radiance normalises it its own way)
+                            let a = &p.rargs;
+                            let raw = DVec3::new(a[3], a[4], a[5]);
+                            let raw = if raw.dot(*n) > 0.0 { raw } else { *n };
+                            Some(FlatSource::disk(*c, raw, *r1))
                         }
                         _ => None,
                     };
