@@ -54,7 +54,11 @@
 //! Sharp channels unweighted with [`fast_recip`], red with a division; decoding with
 //! `(6u′ + 12) − 16v′`, Sharp RGB with `1 − (x + y)`, the position factor with
 //! `(d − ½) − trunc(d)`. The Lambertian part's RGB is desaturated into the gamut like an
-//! element's (constant colours outside the gamut: tests/bsdf_xml.rs).
+//! element's (constant colours outside the gamut: tests/bsdf_xml.rs). The reciprocal estimate
+//! is the processor's own (`rcpss`, as the oracle's on the same machine); processors of
+//! different makers differ in its last bits, so on a chromaticity exactly at a code boundary
+//! the code (like Radiance's) can differ between machines; other architectures divide exactly.
+//! Subnormal or huge sums, where the estimate is infinite or zero, are divided exactly.
 
 use crate::klems::KlemsBasis;
 use crate::model::{Bsdf, Direction, KlemsMatrix, Wavelength};
@@ -311,9 +315,19 @@ fn encode_chroma(
         // The oracle's build sums in single precision and divides by multiplying with the
         // processor's approximate reciprocal after one Newton step ([`fast_recip`]).
         let sum = xv + yv + zv;
-        let (cx, cy) = if sum > 0.0 {
+        let (cx, cy) = if sum.is_normal() && sum < 1e37 {
             let r = fast_recip(sum);
             (xv * r, yv * r)
+        } else if sum > 0.0 {
+            // subnormal or huge sums (the estimate would be infinite or zero, and the Newton
+            // step NaN): the exact quotient of the values as read
+            let (xd, yd, zd) = (
+                x.get(o, i).max(0.0),
+                y.get(o, i).max(0.0),
+                z.get(o, i).max(0.0),
+            );
+            let t = xd + yd + zd;
+            ((xd / t) as f32, (yd / t) as f32)
         } else {
             ((1.0f64 / 3.0) as f32, (1.0f64 / 3.0) as f32)
         };
@@ -698,4 +712,32 @@ pub fn reflection_matrix_with(
         }
     }
     Ok(Some(m))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::KlemsBasis;
+
+    fn constant(v: f64) -> KlemsMatrix {
+        let b = KlemsBasis::quarter();
+        KlemsMatrix {
+            incident: b.clone(),
+            outgoing: b.clone(),
+            values: vec![v; b.len() * b.len()],
+        }
+    }
+
+    /// Subnormal and huge X+Y+Z sums give the grey codes of ordinary values (no NaN, no
+    /// silent zero chromaticity from an infinite or flushed reciprocal estimate).
+    #[test]
+    fn extreme_sums_give_finite_codes() {
+        let (x, y, z) = (constant(0.3), constant(0.3), constant(0.3));
+        let want = encode_chroma(&y, &x, &z, &mut Drand48::new());
+        for v in [1e-40, 1e-44, 3e38, 1e300] {
+            let (x, y, z) = (constant(v), constant(v), constant(v));
+            let got = encode_chroma(&y, &x, &z, &mut Drand48::new());
+            assert_eq!(got, want, "X = Y = Z = {v:e}");
+        }
+    }
 }
