@@ -458,7 +458,7 @@ impl Tracer {
                                 scene.prims[m].name
                             ),
                         },
-                        Shape::Ring { c, n, r0, r1 } => {
+                        Shape::Ring { c, r0, r1, .. } => {
                             if *r0 > 0.0 {
                                 bail!(
                                     "{}: ring '{}' with the light-emitting material '{}': cannot hit \
@@ -471,9 +471,8 @@ impl Tracer {
                             }
                             // the normal as written (Radiance normalises it its own way)
                             let a = &p.rargs;
-                            let raw = DVec3::new(a[3], a[4], a[5]);
-                            let raw = if raw.dot(*n) > 0.0 { raw } else { *n };
-                            Some(FlatSource::disk(*c, raw, *r1))
+                            // (the shape's n is this vector normalised: same direction)
+                            Some(FlatSource::disk(*c, DVec3::new(a[3], a[4], a[5]), *r1))
                         }
                         _ => None,
                     };
@@ -613,9 +612,9 @@ impl Tracer {
             .prims
             .iter()
             .map(|p| match p.ptype.as_str() {
-                "trans" | "trans2" | "dielectric" | "interface" | "mist" | "glass" | "aBSDF" => {
-                    true
-                }
+                // (trans2, interface, mist and aBSDF would pass too, but the material
+                // compiler rejects them before this point)
+                "trans" | "dielectric" | "glass" => true,
                 "BSDF" => p.sargs.first().is_some_and(|t| t != "0"),
                 _ => false,
             })
