@@ -277,3 +277,34 @@ fn fat_cylinder_source_warns_like_radiance() {
     );
     assert_eq!(common::numbers(&out.stdout), vec![1.0, 1.0, 1.0]);
 }
+
+#[test]
+fn jittered_tubes_do_not_depend_on_threads() {
+    let dir = common::scratch("cyl_threads");
+    std::fs::write(dir.join("scene.rad"), SCENE).unwrap();
+    // 96 records: past the 32 traced in order, into the parallel blocks
+    let rays = rays().repeat(3);
+    let run = |n: &str, opts: &[&str]| {
+        let mut c: Command = common::fenestra("rtrace");
+        c.args(["-h", "-ab", "0", "-n", n])
+            .args(opts)
+            .arg("scene.rad")
+            .current_dir(&dir);
+        let out = common::run_stdin(c, rays.as_bytes());
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        out.stdout
+    };
+    for opts in [
+        &["-dj", ".7"][..],
+        &["-dj", ".7", "-ds", ".05", "-dt", ".1"],
+    ] {
+        let one = run("1", opts);
+        let lit = common::numbers(&one).iter().filter(|v| **v > 0.0).count();
+        assert!(lit > 240, "{opts:?}: only {lit} lit values");
+        assert_eq!(one, run("2", opts), "{opts:?}");
+    }
+}
