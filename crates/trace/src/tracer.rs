@@ -23,6 +23,19 @@ use crate::shape::Shape;
 mod cylinder;
 mod flat;
 mod threshold;
+
+/// Most parts of a flat or cylinder source under `-ds` (Radiance's MAXSPART).
+const MAX_PARTS: usize = 64;
+
+/// Radiance's unrandomised choice of a direction across unit `n` (its `-u-` frame), not
+/// yet made unit: the last coordinate axis where |n| < 0.6, crossed with `n`. Flat
+/// sources normalise it with `flat::rad_normalize`, cylinder sources with `normalize`.
+fn across_unnormalised(n: DVec3) -> DVec3 {
+    let i = (0..3).rev().find(|&i| n[i].abs() < 0.6).unwrap_or(0);
+    let mut e = DVec3::ZERO;
+    e[i] = 1.0;
+    e.cross(n)
+}
 use cylinder::CylSource;
 use flat::FlatSource;
 pub use threshold::DirectState;

@@ -18,8 +18,7 @@
 
 use glam::DVec3;
 
-/// Finest subdivision of a cylinder source's axis (Radiance's MAXSPART).
-pub(super) const MAX_PARTS: usize = 64;
+use super::MAX_PARTS;
 
 /// A cylinder light source's sampling geometry.
 pub(super) struct CylSource {
@@ -43,10 +42,7 @@ impl CylSource {
     pub(super) fn new(p0: DVec3, axis: DVec3, len: f64, r: f64) -> CylSource {
         // across the axis: Radiance's unrandomised choice (its -u-), the last coordinate
         // axis with |component| < 0.6 crossed with the axis
-        let i = (0..3).rev().find(|&i| axis[i].abs() < 0.6).unwrap_or(0);
-        let mut e = DVec3::ZERO;
-        e[i] = 1.0;
-        let a = e.cross(axis).normalize();
+        let a = super::across_unnormalised(axis).normalize();
         let w = a * (ACROSS * r);
         let v = w.cross(axis);
         CylSource {

@@ -24,10 +24,8 @@
 
 use glam::DVec3;
 
+use super::MAX_PARTS;
 use crate::polygon::Polygon;
-
-/// Most parts of a flat source under `-ds` (Radiance's MAXSPART).
-pub(super) const MAX_PARTS: usize = 64;
 
 /// 2/√π to 9 digits, as Radiance writes it (3e-9 above the exact value, so a corner of
 /// the square lands just past the rim): maps the square of a ring (side √π × radius)
@@ -85,10 +83,7 @@ pub(super) fn rad_normalize(v: DVec3) -> DVec3 {
 
 /// A unit vector across unit `n` (Radiance's unrandomised choice).
 fn across(n: DVec3) -> DVec3 {
-    let i = (0..3).rev().find(|&i| n[i].abs() < 0.6).unwrap_or(0);
-    let mut e = DVec3::ZERO;
-    e[i] = 1.0;
-    rad_normalize(e.cross(n))
+    rad_normalize(super::across_unnormalised(n))
 }
 
 /// Squared distance from `p` to the line through `a` and `b`.

@@ -378,10 +378,11 @@ impl Tracer {
             .iter()
             .map(|s| match s.geom {
                 SourceGeom::Local(sh) => match shapes[sh] {
-                    Shape::Polygon(_) | Shape::Ring { .. } if opts.ds > 0.0 => {
-                        super::flat::MAX_PARTS
+                    Shape::Polygon(_) | Shape::Ring { .. } | Shape::Cone { .. }
+                        if opts.ds > 0.0 =>
+                    {
+                        super::MAX_PARTS
                     }
-                    Shape::Cone { .. } if opts.ds > 0.0 => super::cylinder::MAX_PARTS,
                     _ => 1,
                 },
                 SourceGeom::Distant(_) | SourceGeom::Virtual { .. } => 1,
