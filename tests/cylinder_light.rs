@@ -75,16 +75,7 @@ fn oracle_tubes_with_no_jitter_equal_radiance() {
         let (t, o) = common::both_rtrace(&oracle, &dir, &opts, &rays);
         let lit = t.iter().filter(|v| **v > 0.0).count();
         assert!(lit > 80, "{extra:?}: only {lit} lit values");
-        let mut worst = 0.0f64;
-        for (k, (a, b)) in t.iter().zip(&o).enumerate() {
-            assert!(
-                (a - b).abs() <= PRINTED * a.abs() + 1e-12,
-                "{extra:?} value {k}: oracle {a} ours {b}"
-            );
-            if *a > 0.0 {
-                worst = worst.max((a - b).abs() / a);
-            }
-        }
+        let worst = common::agree(&format!("{extra:?}"), &t, &o, PRINTED, 1e-12);
         eprintln!("{extra:?}: largest relative difference {worst:.3e}");
     }
 }
@@ -136,26 +127,9 @@ fn oracle_rcontrib_tube_contributions() {
         assert_eq!(t.len(), 32 * 9);
         assert_eq!(t.len(), o.len());
         assert!(t.iter().filter(|v| **v > 0.0).count() > 150);
-        let mut worst = 0.0f64;
-        for (k, (a, b)) in t.iter().zip(&o).enumerate() {
-            assert!(
-                (a - b).abs() <= PRINTED * a.abs() + 1e-12,
-                "{extra:?} value {k}: oracle {a} ours {b}"
-            );
-            if *a > 0.0 {
-                worst = worst.max((a - b).abs() / a);
-            }
-        }
+        let worst = common::agree(&format!("{extra:?}"), &t, &o, PRINTED, 1e-12);
         eprintln!("{extra:?}: largest relative difference {worst:.3e}");
     }
-}
-
-/// Mean and its standard error of `v`.
-fn mean_sem(v: &[f64]) -> (f64, f64) {
-    let n = v.len() as f64;
-    let m = v.iter().sum::<f64>() / n;
-    let var = v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0);
-    (m, (var / n).sqrt())
 }
 
 #[test]
@@ -190,7 +164,7 @@ fn oracle_jittered_tubes_agree_within_monte_carlo_error() {
                     .copied()
                     .collect()
             };
-            let ((mt, st), (mo, so)) = (mean_sem(&pick(&t)), mean_sem(&pick(&o)));
+            let ((mt, st), (mo, so)) = (common::mean_sem(&pick(&t)), common::mean_sem(&pick(&o)));
             // 4 combined standard errors: a false failure about once in 16000 checks.
             // Measured at the first floor point: spread per record 39% of the mean with
             // -ds 0, 5.6% with the default -ds .2, 0.5% with -ds .05; over the 9 checks
@@ -204,19 +178,6 @@ fn oracle_jittered_tubes_agree_within_monte_carlo_error() {
             );
             assert!(st > 0.0 && so > 0.0 && so < 1.5 * st && st < 1.5 * so);
         }
-    }
-}
-
-fn fails_with(scene: &str, want: &[&str]) {
-    let dir = common::scratch("cyl_err");
-    std::fs::write(dir.join("bad.rad"), scene).unwrap();
-    let mut c: Command = common::fenestra("rtrace");
-    c.args(["-h", "bad.rad"]).current_dir(&dir);
-    let out = common::run_stdin(c, b"0 0 0 0 0 1\n");
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
-    for w in want {
-        assert!(err.contains(w), "missing '{w}' in: {err}");
     }
 }
 
@@ -234,7 +195,8 @@ fn light_on_a_cone_cup_or_tube_is_an_error() {
             "spotlight lm 0 0 7 10 10 10 90 0 0 -1",
         ] {
             let scene = format!("void {mat}\n\nlm {kind} lamp {args}\n");
-            fails_with(
+            common::fails_with(
+                "cyl_err",
                 &scene,
                 &["bad.rad:3", &format!("{kind} 'lamp'"), "illegal material"],
             );

@@ -90,22 +90,6 @@ fn scene(lamp: &str) -> String {
     format!("{lamp}\n{ROOM}")
 }
 
-/// Checks every value within [`PRINTED`]; returns the largest relative difference.
-fn agree(what: &str, t: &[f64], o: &[f64]) -> f64 {
-    assert_eq!(t.len(), o.len(), "{what}");
-    let mut worst = 0.0f64;
-    for (k, (a, b)) in t.iter().zip(o).enumerate() {
-        assert!(
-            (a - b).abs() <= PRINTED * a.abs() + 1e-12,
-            "{what} value {k}: oracle {a} ours {b}"
-        );
-        if *a > 0.0 {
-            worst = worst.max((a - b).abs() / a);
-        }
-    }
-    worst
-}
-
 #[test]
 fn oracle_flat_sources_with_no_jitter_equal_radiance() {
     let Some(oracle) = common::oracle() else {
@@ -121,7 +105,7 @@ fn oracle_flat_sources_with_no_jitter_equal_radiance() {
             let (t, o) = common::both_rtrace(&oracle, &dir, &opts, &pts);
             let lit = t.iter().filter(|v| **v > 0.0).count();
             assert!(lit > 150, "{name} {extra:?}: only {lit} lit values");
-            let worst = agree(&format!("{name} {extra:?}"), &t, &o);
+            let worst = common::agree(&format!("{name} {extra:?}"), &t, &o, PRINTED, 1e-12);
             eprintln!("{name} {extra:?}: largest relative difference {worst:.3e}");
         }
     }
@@ -146,7 +130,7 @@ fn oracle_thresholded_flat_sources_equal_radiance_over_32_records() {
             let mut opts = vec!["-h", "-I", "-ab", "0", "-u-", "-dj", "0"];
             opts.extend_from_slice(extra);
             let (t, o) = common::both_rtrace(&oracle, &dir, &opts, &pts);
-            let worst = agree(&format!("{name} {extra:?}"), &t, &o);
+            let worst = common::agree(&format!("{name} {extra:?}"), &t, &o, PRINTED, 1e-12);
             eprintln!("{name} {extra:?}: largest relative difference {worst:.3e}");
         }
     }
@@ -180,18 +164,16 @@ fn oracle_rcontrib_flat_contributions() {
             let (t, o) = (common::numbers(&t.stdout), common::numbers(&o.stdout));
             assert_eq!(t.len(), 126 * 3);
             assert!(t.iter().filter(|v| **v > 0.0).count() > 150);
-            let worst = agree(&format!("rcontrib {name} {extra:?}"), &t, &o);
+            let worst = common::agree(
+                &format!("rcontrib {name} {extra:?}"),
+                &t,
+                &o,
+                PRINTED,
+                1e-12,
+            );
             eprintln!("rcontrib {name} {extra:?}: largest relative difference {worst:.3e}");
         }
     }
-}
-
-/// Mean and its standard error of `v`.
-fn mean_sem(v: &[f64]) -> (f64, f64) {
-    let n = v.len() as f64;
-    let m = v.iter().sum::<f64>() / n;
-    let var = v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0);
-    (m, (var / n).sqrt())
 }
 
 #[test]
@@ -243,7 +225,8 @@ fn oracle_jittered_flat_sources_agree_within_monte_carlo_error() {
                         .copied()
                         .collect()
                 };
-                let ((mt, st), (mo, so)) = (mean_sem(&pick(&t)), mean_sem(&pick(&o)));
+                let ((mt, st), (mo, so)) =
+                    (common::mean_sem(&pick(&t)), common::mean_sem(&pick(&o)));
                 // 4 combined standard errors: a false failure about once in 16000 checks
                 let tol = 4.0 * (st * st + so * so).sqrt();
                 eprintln!(
@@ -299,27 +282,16 @@ fn jittered_flat_sources_do_not_depend_on_threads() {
     }
 }
 
-fn fails_with(scene: &str, want: &[&str]) {
-    let dir = common::scratch("flat_err");
-    std::fs::write(dir.join("bad.rad"), scene).unwrap();
-    let mut c: Command = common::fenestra("rtrace");
-    c.args(["-h", "bad.rad"]).current_dir(&dir);
-    let out = common::run_stdin(c, b"0 0 0 0 0 1\n");
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
-    for w in want {
-        assert!(err.contains(w), "missing '{w}' in: {err}");
-    }
-}
-
 #[test]
 fn flat_sources_radiance_cannot_aim_at_are_errors() {
     // Radiance: "cannot hit source center" for both
-    fails_with(
+    common::fails_with(
+        "flat_err",
         "void light l 0 0 3 1 1 1\n\nl ring r 0 0 8 0 0 2 0 0 -1 .2 .5\n",
         &["bad.rad:3", "ring 'r'", "cannot hit source center"],
     );
-    fails_with(
+    common::fails_with(
+        "flat_err",
         "void illum l 0 0 3 1 1 1\nl polygon p 0 0 18 0 0 2 0 1 2 1 1 2 .1 .9 2 .1 .1 2 1 0 2\n",
         &["bad.rad:2", "polygon 'p'", "cannot hit source center"],
     );

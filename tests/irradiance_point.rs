@@ -52,14 +52,7 @@ fn compare(what: &str, theirs: &[f64], ours: &[f64]) {
     assert_eq!(theirs.len(), ours.len(), "{what}");
     let lit = theirs.iter().filter(|v| **v > 0.0).count();
     assert!(lit * 4 > theirs.len() * 3, "{what}: only {lit} lit values");
-    let mut worst = 0.0f64;
-    for (k, (a, b)) in theirs.iter().zip(ours).enumerate() {
-        assert!(
-            (a - b).abs() <= PRINTED * a.abs() + 1e-9,
-            "{what} value {k}: oracle {a} ours {b}"
-        );
-        worst = worst.max((a - b).abs() / a.abs().max(1e-12));
-    }
+    let worst = common::agree(what, theirs, ours, PRINTED, 1e-9);
     eprintln!("{what}: largest relative difference {worst:.2e}");
 }
 
@@ -99,11 +92,6 @@ fn oracle_irradiance_is_taken_off_the_surface() {
     // each record: the lamp's rgb, the tube's rgb; only the sums need to be lit
     let sum = |v: &[f64]| -> Vec<f64> { v.chunks(6).map(|c| c[0] + c[3]).collect() };
     compare("rcontrib -I (sum)", &sum(&tt), &sum(&oo));
-    for (k, (a, b)) in tt.iter().zip(&oo).enumerate() {
-        assert!(
-            (a - b).abs() <= PRINTED * a.abs() + 1e-9,
-            "rcontrib value {k}: oracle {a} ours {b}"
-        );
-    }
+    common::agree("rcontrib", &tt, &oo, PRINTED, 1e-9);
     let _ = std::fs::remove_dir_all(&dir);
 }

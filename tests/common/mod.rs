@@ -168,3 +168,44 @@ pub fn xorshift(mut seed: u64) -> impl FnMut() -> f64 {
         (seed >> 11) as f64 / (1u64 << 53) as f64
     }
 }
+
+/// Asserts |a − b| ≤ `rel`·|a| + `abs` for each pair of the oracle's values `theirs` and
+/// fenestra's `ours` (lists of equal length); returns the largest relative difference over
+/// the oracle's positive values, for the tests to print.
+pub fn agree(what: &str, theirs: &[f64], ours: &[f64], rel: f64, abs: f64) -> f64 {
+    assert_eq!(theirs.len(), ours.len(), "{what}");
+    let mut worst = 0.0f64;
+    for (k, (a, b)) in theirs.iter().zip(ours).enumerate() {
+        assert!(
+            (a - b).abs() <= rel * a.abs() + abs,
+            "{what} value {k}: oracle {a} ours {b}"
+        );
+        if *a > 0.0 {
+            worst = worst.max((a - b).abs() / a);
+        }
+    }
+    worst
+}
+
+/// Mean of `v` and the standard error of that mean.
+pub fn mean_sem(v: &[f64]) -> (f64, f64) {
+    let n = v.len() as f64;
+    let m = v.iter().sum::<f64>() / n;
+    let var = v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0);
+    (m, (var / n).sqrt())
+}
+
+/// Runs fenestra's rtrace on `scene` (written to a scratch directory named `scratch`) and
+/// asserts that it fails with every string of `want` in its error output.
+pub fn fails_with(scratch_name: &str, scene: &str, want: &[&str]) {
+    let dir = scratch(scratch_name);
+    std::fs::write(dir.join("bad.rad"), scene).unwrap();
+    let mut c = fenestra("rtrace");
+    c.args(["-h", "bad.rad"]).current_dir(&dir);
+    let out = run_stdin(c, b"0 0 0 0 0 1\n");
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    for w in want {
+        assert!(err.contains(w), "missing '{w}' in: {err}");
+    }
+}
