@@ -718,20 +718,12 @@ impl Tracer {
         org: DVec3,
         dir: DVec3,
     ) -> [f64; 3] {
-        let mut cx = Ctx {
-            rng: Rng::for_ray(self.opts.seed, ray_index),
-            rays: 0,
-            tracked: &[],
-            sink: None,
-            ds: self.state_for(st),
-        };
+        let cx = self.ctx(ray_index, &[], None, self.state_for(st));
         let d = dir.normalize_or_zero();
         if d == DVec3::ZERO {
             return [0.0; 3];
         }
-        let v = self.trace(&Self::primary(org, d), &mut cx);
-        self.count(&cx);
-        v.to_array()
+        self.run(&Self::primary(org, d), cx)
     }
 
     /// Irradiance at `point` itself on a surface facing `normal` (rtrace `-I` evaluates
@@ -749,20 +741,12 @@ impl Tracer {
         point: DVec3,
         normal: DVec3,
     ) -> [f64; 3] {
-        let mut cx = Ctx {
-            rng: Rng::for_ray(self.opts.seed, ray_index),
-            rays: 0,
-            tracked: &[],
-            sink: None,
-            ds: self.state_for(st),
-        };
+        let cx = self.ctx(ray_index, &[], None, self.state_for(st));
         let n = normal.normalize_or_zero();
         if n == DVec3::ZERO {
             return [0.0; 3];
         }
-        let v = self.irradiance_in(point, n, &mut cx);
-        self.count(&cx);
-        v.to_array()
+        self.run_irradiance(point, n, cx)
     }
 
     /// Traces a ray and reports every ray that reaches a surface whose direct modifier
@@ -794,20 +778,11 @@ impl Tracer {
         if d == DVec3::ZERO || len.is_nan() || len <= 0.0 {
             return [0.0; 3];
         }
-        let mut cx = Ctx {
-            rng: Rng::for_ray(self.opts.seed, ray_index),
-            rays: 0,
-            tracked,
-            sink: Some(sink),
-            ds: None,
-        };
         let r = Ray {
             tmax: len,
             ..Self::primary(org, d)
         };
-        let v = self.trace(&r, &mut cx);
-        self.count(&cx);
-        v.to_array()
+        self.run(&r, self.ctx(ray_index, tracked, Some(sink), None))
     }
 
     /// As [`contributions`](Self::contributions) for an irradiance request (`-I+`):
@@ -824,14 +799,38 @@ impl Tracer {
         if n == DVec3::ZERO {
             return [0.0; 3];
         }
-        let mut cx = Ctx {
+        let cx = self.ctx(ray_index, tracked, Some(sink), None);
+        self.run_irradiance(point, n, cx)
+    }
+
+    /// The tracing context of input ray `ray_index` (its random numbers fixed by the seed
+    /// and the index).
+    fn ctx<'a>(
+        &self,
+        ray_index: u64,
+        tracked: &'a [bool],
+        sink: Option<&'a mut dyn FnMut(Contribution)>,
+        ds: Option<&'a mut DirectState>,
+    ) -> Ctx<'a> {
+        Ctx {
             rng: Rng::for_ray(self.opts.seed, ray_index),
             rays: 0,
             tracked,
-            sink: Some(sink),
-            ds: None,
-        };
-        let v = self.irradiance_in(point, n, &mut cx);
+            sink,
+            ds,
+        }
+    }
+
+    /// Traces the primary ray `r` in `cx` and adds its rays to the tracer's count.
+    fn run(&self, r: &Ray, mut cx: Ctx) -> [f64; 3] {
+        let v = self.trace(r, &mut cx);
+        self.count(&cx);
+        v.to_array()
+    }
+
+    /// Irradiance at `p` facing unit `n` in `cx`, counting its rays.
+    fn run_irradiance(&self, p: DVec3, n: DVec3, mut cx: Ctx) -> [f64; 3] {
+        let v = self.irradiance_in(p, n, &mut cx);
         self.count(&cx);
         v.to_array()
     }
@@ -2193,20 +2192,11 @@ impl Tracer {
         if d == DVec3::ZERO {
             return [0.0; 3];
         }
-        let mut cx = Ctx {
-            rng: Rng::for_ray(self.opts.seed, ray_index),
-            rays: 0,
-            tracked: &[],
-            sink: None,
-            ds: self.state_for(st),
-        };
         let r = Ray {
             flags: IRRAD,
             ..Self::primary(org, d)
         };
-        let v = self.trace(&r, &mut cx);
-        self.count(&cx);
-        v.to_array()
+        self.run(&r, self.ctx(ray_index, &[], None, self.state_for(st)))
     }
 
     /// As [`contributions_limited`](Self::contributions_limited) for rcontrib `-i`: the
@@ -2225,21 +2215,12 @@ impl Tracer {
         if d == DVec3::ZERO || len.is_nan() || len <= 0.0 {
             return [0.0; 3];
         }
-        let mut cx = Ctx {
-            rng: Rng::for_ray(self.opts.seed, ray_index),
-            rays: 0,
-            tracked,
-            sink: Some(sink),
-            ds: None,
-        };
         let r = Ray {
             tmax: len,
             flags: IRRAD,
             ..Self::primary(org, d)
         };
-        let v = self.trace(&r, &mut cx);
-        self.count(&cx);
-        v.to_array()
+        self.run(&r, self.ctx(ray_index, tracked, Some(sink), None))
     }
 }
 
