@@ -469,13 +469,15 @@ impl<'a> Fc<'a> {
     }
 
     /// Removes the `Add` (`mul` false) or `Mul` op just written to the newest temporary
-    /// `r` when `keep` names the operand it equals (`x + 0`, `x * 1`), and returns that
-    /// operand; otherwise returns `r` unchanged.
+    /// `r` when one operand is the identity (`x + 0`, `x * 1`: `identity`) and the other
+    /// may stand for the result (`stands`; the right operand is tried first), and returns
+    /// that other operand; otherwise returns `r` unchanged.
     fn elide_identity(
         &mut self,
         r: u32,
         mul: bool,
-        keep: impl Fn(&Self, u32, u32) -> Option<u32>,
+        identity: impl Fn(&Self, u32) -> bool,
+        stands: impl Fn(&Self, u32) -> bool,
     ) -> u32 {
         let (d, a, b) = match (self.ops.last().copied(), mul) {
             (Some(Op::Add { d, a, b }), false) | (Some(Op::Mul { d, a, b }), true) => (d, a, b),
@@ -484,7 +486,11 @@ impl<'a> Fc<'a> {
         if d != r || r + 1 != self.ntemp {
             return r;
         }
-        let Some(k) = keep(self, a, b) else {
+        let k = if identity(self, b) && stands(self, a) {
+            a
+        } else if identity(self, a) && stands(self, b) {
+            b
+        } else {
             return r;
         };
         self.ops.pop();
@@ -859,17 +865,12 @@ impl<'a> Fc<'a> {
                     |d, a, b| Op::Add { d, a, b },
                 )?;
                 // x + ±0 is x when x is itself a sum or a floor (never -0)
-                Ok(self.elide_identity(r, false, |s, a, b| {
-                    let zero = |q: u32| s.kval(q) == Some(0.0);
-                    let nz = |q: u32| !is_k(q) && s.no_neg_zero.get(q as usize) == Some(&true);
-                    if zero(b) && nz(a) {
-                        Some(a)
-                    } else if zero(a) && nz(b) {
-                        Some(b)
-                    } else {
-                        None
-                    }
-                }))
+                Ok(self.elide_identity(
+                    r,
+                    false,
+                    |s, q| s.kval(q) == Some(0.0),
+                    |s, q| !is_k(q) && s.no_neg_zero.get(q as usize) == Some(&true),
+                ))
             }
             Node::Sub(p) => self.binary(
                 &p.0,
@@ -887,16 +888,7 @@ impl<'a> Fc<'a> {
                     |d, a, b| Op::Mul { d, a, b },
                 )?;
                 // x*1 is x (also for infinities, NaNs and signed zeros)
-                Ok(self.elide_identity(r, true, |s, a, b| {
-                    let one = |q: u32| s.kval(q) == Some(1.0);
-                    if one(b) {
-                        Some(a)
-                    } else if one(a) {
-                        Some(b)
-                    } else {
-                        None
-                    }
-                }))
+                Ok(self.elide_identity(r, true, |s, q| s.kval(q) == Some(1.0), |_, _| true))
             }
             Node::Div(p) => self.binary(
                 &p.0,
