@@ -100,7 +100,7 @@ pub fn component_with(
         [0.0; 3]
     };
     let lambertian_xyz = lambertian.map(|v| std::f64::consts::PI * v);
-    let totals: Vec<f64> = (0..y.incident.len()).map(|i| y.hemispherical(i)).collect();
+    let totals = totals(y);
     let max_total = totals.iter().copied().fold(0.0, f64::max);
     let lmin = |k: &KlemsBasis| k.lambdas().into_iter().fold(f64::INFINITY, f64::min);
     let lam_min = lmin(&y.outgoing).min(lmin(&y.incident));
@@ -117,6 +117,12 @@ pub fn component_with(
         diffuse_total,
         totals,
     })
+}
+
+/// Directional-hemispherical total per incident patch of a matrix (no Lambertian split, so no
+/// colour dither: [`ComponentCheck::totals`] without the rest of [`component_with`]).
+fn totals(y: &KlemsMatrix) -> Vec<f64> {
+    (0..y.incident.len()).map(|i| y.hemispherical(i)).collect()
 }
 
 /// Radiance's relative difference: `|a − b| / (max(a, b) + 1e-6)`.
@@ -176,7 +182,9 @@ pub fn reflection_reciprocity(b: &Bsdf, d: Direction) -> Option<Reciprocity> {
 /// Lambertian parts of the file loaded first in a process (see
 /// [`transmission_reciprocity_with`]).
 pub fn transmission_reciprocity(b: &Bsdf) -> Option<Reciprocity> {
-    let l = |d| component(b, d).map_or(0.0, |c| c.lambertian_y);
+    // One fresh generator, as `component` gives each call: both parts from the same dither.
+    let colour = crate::radiance::colour_lambertians(b, &mut crate::radiance::Drand48::new());
+    let l = |d| component_with(b, d, &colour).map_or(0.0, |c| c.lambertian_y);
     transmission_reciprocity_with(
         b,
         l(Direction::TransmissionFront),
@@ -204,8 +212,9 @@ pub fn energy_balance(b: &Bsdf, exterior: bool) -> Option<(f64, usize)> {
     } else {
         (Direction::TransmissionBack, Direction::ReflectionBack)
     };
-    let t = component(b, t).map(|c| c.totals);
-    let r = component(b, r).map(|c| c.totals);
+    // Only the totals are read: they do not depend on the Lambertian split or its dither.
+    let t = b.klems(t, &Wavelength::Visible).map(totals);
+    let r = b.klems(r, &Wavelength::Visible).map(totals);
     let sum: Vec<f64> = match (t, r) {
         (None, None) => return None,
         (Some(t), None) => t,
