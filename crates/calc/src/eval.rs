@@ -274,36 +274,13 @@ impl Compiled {
     /// Whether any definition, function or channel refers to variable `v` (e.g. to
     /// know whether a host must keep setting a counter such as rcalc's `recno`).
     pub fn references_var(&self, v: VarId) -> bool {
-        fn walk(n: &Node, v: u32) -> bool {
-            match n {
-                Node::Var(i) => *i == v,
-                Node::Lib(_, a) | Node::Neg(a) | Node::Math1(_, a) => walk(a, v),
-                Node::Add(p)
-                | Node::Sub(p)
-                | Node::Mul(p)
-                | Node::Div(p)
-                | Node::Pow(p)
-                | Node::Atan2(p) => walk(&p.0, v) || walk(&p.1, v),
-                Node::If(t) => walk(&t.0, v) || walk(&t.1, v) || walk(&t.2, v),
-                Node::Builtin(_, a)
-                | Node::CallUser(_, a)
-                | Node::CallHost(_, a)
-                | Node::CallParam(_, a) => a.iter().any(|a| walk(a, v)),
-                Node::Num(_)
-                | Node::NumClr(_)
-                | Node::Chan(_)
-                | Node::Param(_)
-                | Node::FuncRef(_)
-                | Node::Fail(_) => false,
-            }
-        }
-        let v = v.0;
+        let walk = |n: &Node| n.any(&|n| matches!(n, Node::Var(i) if *i == v.0));
         self.vars
             .iter()
-            .any(|s| matches!(s, VarSlot::Def(n, _) if walk(n, v)))
-            || self.funcs.iter().any(|f| walk(&f.body, v))
-            || self.chans.iter().any(|(_, n)| walk(n, v))
-            || self.exprs.iter().any(|n| walk(n, v))
+            .any(|s| matches!(s, VarSlot::Def(n, _) if walk(n)))
+            || self.funcs.iter().any(|f| walk(&f.body))
+            || self.chans.iter().any(|(_, n)| walk(n))
+            || self.exprs.iter().any(walk)
     }
 
     /// Whether a `:` constant was left to be computed at its first evaluation (it

@@ -181,22 +181,9 @@ fn lib_reduced(name: &'static str, arg: Node) -> Node {
     }
 }
 
+/// Whether `n` uses a parameter of the enclosing function (or calls one).
 fn contains_param(n: &Node) -> bool {
-    match n {
-        Node::Param(_) | Node::CallParam(..) => true,
-        Node::Neg(a) | Node::Math1(_, a) | Node::Lib(_, a) => contains_param(a),
-        Node::Add(q)
-        | Node::Sub(q)
-        | Node::Mul(q)
-        | Node::Div(q)
-        | Node::Pow(q)
-        | Node::Atan2(q) => contains_param(&q.0) || contains_param(&q.1),
-        Node::If(t) => contains_param(&t.0) || contains_param(&t.1) || contains_param(&t.2),
-        Node::Builtin(_, a) | Node::CallUser(_, a) | Node::CallHost(_, a) => {
-            a.iter().any(contains_param)
-        }
-        _ => false,
-    }
+    n.any(&|n| matches!(n, Node::Param(_) | Node::CallParam(..)))
 }
 
 /// Folds constants in place; returns the `:` constants whose value raised an error

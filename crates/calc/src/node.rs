@@ -54,4 +54,33 @@ impl Node {
             _ => None,
         }
     }
+
+    /// Whether `f` holds for this node or any node below it (checked before its
+    /// operands, left to right, stopping at the first hit).
+    pub(crate) fn any(&self, f: &impl Fn(&Node) -> bool) -> bool {
+        if f(self) {
+            return true;
+        }
+        match self {
+            Node::Lib(_, a) | Node::Neg(a) | Node::Math1(_, a) => a.any(f),
+            Node::Add(p)
+            | Node::Sub(p)
+            | Node::Mul(p)
+            | Node::Div(p)
+            | Node::Pow(p)
+            | Node::Atan2(p) => p.0.any(f) || p.1.any(f),
+            Node::If(t) => t.0.any(f) || t.1.any(f) || t.2.any(f),
+            Node::Builtin(_, a)
+            | Node::CallUser(_, a)
+            | Node::CallHost(_, a)
+            | Node::CallParam(_, a) => a.iter().any(|a| a.any(f)),
+            Node::Num(_)
+            | Node::NumClr(_)
+            | Node::Var(_)
+            | Node::Chan(_)
+            | Node::Param(_)
+            | Node::FuncRef(_)
+            | Node::Fail(_) => false,
+        }
+    }
 }
