@@ -159,6 +159,8 @@ struct Source {
     prim: usize,
     /// A polygon or ring source's sampling geometry.
     flat: Option<FlatSource>,
+    /// A cylinder source's sampling geometry.
+    cyl: Option<CylSource>,
 }
 
 #[derive(Debug, Clone)]
@@ -489,11 +491,18 @@ impl Tracer {
                         }
                         _ => None,
                     };
+                    let cyl = match shapes[s] {
+                        Shape::Cone {
+                            p0, axis, len, r0, ..
+                        } => Some(CylSource::new(p0, axis, len, r0)),
+                        _ => None,
+                    };
                     sources.push(Source {
                         geom: SourceGeom::Local(s),
                         mat: m,
                         prim: surf_prim[s],
                         flat,
+                        cyl,
                     });
                 }
             }
@@ -506,6 +515,7 @@ impl Tracer {
                         mat: d.mat,
                         prim: d.prim,
                         flat: None,
+                        cyl: None,
                     });
                 }
             }
@@ -531,6 +541,7 @@ impl Tracer {
                             mat: sources[b].mat,
                             prim: sources[b].prim,
                             flat: None,
+                            cyl: None,
                         });
                     }
                 }
@@ -774,12 +785,29 @@ impl Tracer {
         tracked: &[bool],
         sink: &mut impl FnMut(Contribution),
     ) -> [f64; 3] {
+        self.contributions_flagged(ray_index, org, dir, len, 0, tracked, sink)
+    }
+
+    /// The primary ray of rcontrib's normal (`flags` 0) and `-i` (`IRRAD`) modes, ending
+    /// after `len`, traced with `sink` receiving the tracked contributions.
+    #[allow(clippy::too_many_arguments)]
+    fn contributions_flagged(
+        &self,
+        ray_index: u64,
+        org: DVec3,
+        dir: DVec3,
+        len: f64,
+        flags: u8,
+        tracked: &[bool],
+        sink: &mut impl FnMut(Contribution),
+    ) -> [f64; 3] {
         let d = dir.normalize_or_zero();
         if d == DVec3::ZERO || len.is_nan() || len <= 0.0 {
             return [0.0; 3];
         }
         let r = Ray {
             tmax: len,
+            flags,
             ..Self::primary(org, d)
         };
         self.run(&r, self.ctx(ray_index, tracked, Some(sink), None))
@@ -1752,11 +1780,7 @@ impl Tracer {
                         },
                     );
                 };
-                if let Shape::Cone {
-                    p0, axis, len, r0, ..
-                } = self.accel.shapes[sh]
-                {
-                    let cyl = CylSource::new(p0, axis, len, r0);
+                if let Some(cyl) = &s.cyl {
                     let parts = cyl.partitions(p, self.opts.ds, weight);
                     let count = parts.len();
                     let samples: Vec<(DVec3, f64)> = parts
@@ -2211,16 +2235,7 @@ impl Tracer {
         tracked: &[bool],
         sink: &mut impl FnMut(Contribution),
     ) -> [f64; 3] {
-        let d = dir.normalize_or_zero();
-        if d == DVec3::ZERO || len.is_nan() || len <= 0.0 {
-            return [0.0; 3];
-        }
-        let r = Ray {
-            tmax: len,
-            flags: IRRAD,
-            ..Self::primary(org, d)
-        };
-        self.run(&r, self.ctx(ray_index, tracked, Some(sink), None))
+        self.contributions_flagged(ray_index, org, dir, len, IRRAD, tracked, sink)
     }
 }
 

@@ -21,6 +21,7 @@ use glam::DVec3;
 use super::MAX_PARTS;
 
 /// A cylinder light source's sampling geometry.
+#[derive(Debug, Clone)]
 pub(super) struct CylSource {
     /// Midpoint of the axis.
     mid: DVec3,
