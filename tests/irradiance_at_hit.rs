@@ -60,17 +60,9 @@ const TOL: f64 = 5e-5;
 /// Checks agreement within [`TOL`]; at least `min_lit` of the reference values are
 /// non-zero.
 fn compare(what: &str, theirs: &[f64], ours: &[f64], min_lit: usize) {
-    assert_eq!(theirs.len(), ours.len(), "{what}");
     let lit = theirs.iter().filter(|v| **v > 0.0).count();
     assert!(lit >= min_lit, "{what}: only {lit} lit values");
-    let mut worst = 0.0f64;
-    for (k, (a, b)) in theirs.iter().zip(ours).enumerate() {
-        assert!(
-            (a - b).abs() <= TOL * a.abs() + 1e-12,
-            "{what} value {k}: oracle {a} ours {b}"
-        );
-        worst = worst.max((a - b).abs() / a.abs().max(1e-12));
-    }
+    let worst = common::agree(what, theirs, ours, TOL, 1e-12);
     eprintln!("{what}: largest relative difference {worst:.2e}");
 }
 

@@ -59,21 +59,12 @@ const TOL: f64 = 5e-5;
 /// Compares the oracle's values with ours and asks for at least `min_lit` of the oracle's
 /// values to be positive, so that two tools printing only zeros do not pass.
 fn check(what: &str, theirs: &[f64], ours: &[f64], min_lit: usize) -> f64 {
-    assert_eq!(theirs.len(), ours.len(), "{what}");
     let lit = theirs.iter().filter(|v| **v > 0.0).count();
     assert!(
         lit >= min_lit,
         "{what}: only {lit} lit values (at least {min_lit} expected)"
     );
-    let mut worst = 0.0f64;
-    for (k, (a, b)) in theirs.iter().zip(ours).enumerate() {
-        let rel = (a - b).abs() / a.abs().max(1e-12);
-        assert!(
-            (a - b).abs() <= TOL * a.abs() + 1e-9,
-            "{what} value {k}: oracle {a} ours {b}"
-        );
-        worst = worst.max(rel);
-    }
+    let worst = common::agree(what, theirs, ours, TOL, 1e-9);
     eprintln!("{what}: largest relative difference {worst:.2e}");
     worst
 }
