@@ -20,6 +20,15 @@ pub(crate) enum Node {
     Grid { log2: u32, values: Vec<f32> },
 }
 
+/// Edge of the smallest leaf of `node` along one dimension (1/2^depth, a grid's cells counted
+/// as one level of `log2` halvings).
+pub(crate) fn smallest_leaf_edge(node: &Node) -> f64 {
+    match node {
+        Node::Branch(ch) => 0.5 * ch.iter().map(smallest_leaf_edge).fold(1.0, f64::min),
+        Node::Grid { log2, .. } => 1.0 / (1u64 << log2) as f64,
+    }
+}
+
 /// A leaf found by a lookup: its value and its hypercube (lower corner, edge).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Leaf {
@@ -155,18 +164,6 @@ impl TensorTree {
             let b = disk_to_square(rot[0], rot[1]);
             self.lookup(&[p0.max(0.0), b.0, b.1])
         }
-    }
-
-    /// Finest cell size along one dimension (1/2^depth).
-    #[cfg(test)]
-    pub(crate) fn finest_cell(&self) -> f64 {
-        fn walk(n: &Node) -> f64 {
-            match n {
-                Node::Branch(ch) => 0.5 * ch.iter().map(walk).fold(1.0, f64::min),
-                Node::Grid { log2, .. } => 1.0 / (1u64 << log2) as f64,
-            }
-        }
-        walk(&self.root)
     }
 }
 

@@ -31,7 +31,7 @@ use std::f64::consts::PI;
 use crate::check::{ComponentCheck, Reciprocity, LAMBERTIAN_MIN, TREE_LAMBERTIAN_MAX};
 use crate::model::{BlockData, Bsdf, DataStructure, Direction, Wavelength};
 use crate::radiance::{from_sharp, to_sharp, Drand48, XYZ_FROM_SHARP_F};
-use crate::tree::{disk_to_square, leaf_at, square_to_disk, Leaf, Node};
+use crate::tree::{disk_to_square, leaf_at, smallest_leaf_edge, square_to_disk, Leaf, Node};
 
 /// The small margin the reproduced arithmetic uses: normal incidence sits this far below the
 /// middle of a rank-3 tree's incident coordinate, strip loops stop this short of their end, a
@@ -85,13 +85,7 @@ impl Tree {
 
     /// Edge of the smallest leaf.
     fn smallest_leaf(&self) -> f64 {
-        fn walk(n: &Node) -> f64 {
-            match n {
-                Node::Branch(ch) => 0.5 * ch.iter().map(walk).fold(1.0, f64::min),
-                Node::Grid { log2, .. } => 1.0 / (1u64 << log2) as f64,
-            }
-        }
-        walk(&self.root)
+        smallest_leaf_edge(&self.root)
     }
 
     /// Edge of the smallest leaf met by the slice through `pos` in the dimensions of `mask`.
@@ -1182,7 +1176,7 @@ mod table_tests {
     /// largest directional total, angle in degrees = 2 × the finest cell in radians). Rank 3:
     /// incident position 0.5 − r/2 covers [0, 0.5) from r = 1 (grazing) to 0 (normal).
     fn grid_totals(t: &TensorTree) -> (f64, f64, f64, f64) {
-        let cell = t.finest_cell();
+        let cell = smallest_leaf_edge(t.root());
         let n = (1.0 / cell).round().max(1.0) as usize;
         let c = |k: usize| (k as f64 + 0.5) / n as f64;
         let hemi = |inc: &[f64]| -> f64 {
