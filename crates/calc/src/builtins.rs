@@ -188,6 +188,21 @@ pub fn select_index(x: f64) -> Option<usize> {
     }
 }
 
+/// `in(x)` / `arg(x)` over `vals` (the input channels, the primitive's real arguments):
+/// index `(int)(x + .5)`, 0 gives the count, 1 to the count the value; otherwise the
+/// index as `Err` (`in` gives 0 there, `arg` raises an error).
+#[inline]
+pub fn in_arg_index(x: f64, vals: &[f64]) -> Result<f64, i64> {
+    let i = (x + 0.5) as i64;
+    if i == 0 {
+        Ok(vals.len() as f64)
+    } else if i > 0 && (i as usize) <= vals.len() {
+        Ok(vals[i as usize - 1])
+    } else {
+        Err(i)
+    }
+}
+
 /// Radiance's `rand(x)`: a deterministic hash of `x` into [0, 1).
 #[inline]
 #[allow(clippy::approx_constant)] // Radiance's truncated constants, kept for identical output

@@ -717,28 +717,17 @@ impl Compiled {
             }
             Builtin::In => {
                 let n = self.eval(&args[0], st, fr);
-                let i = (n + 0.5) as i64;
-                if i == 0 {
-                    st.chans.len() as f64
-                } else if i > 0 {
-                    st.chans.get(i as usize - 1).copied().unwrap_or(0.0)
-                } else {
-                    0.0
-                }
+                builtins::in_arg_index(n, &st.chans).unwrap_or(0.0)
             }
             Builtin::Arg => {
                 let n = self.eval(&args[0], st, fr);
-                let i = (n + 0.5) as i64;
-                if i == 0 {
-                    st.fargs.len() as f64
-                } else if i > 0 && (i as usize) <= st.fargs.len() {
-                    st.fargs[i as usize - 1]
-                } else {
-                    self.dyn_fail(
+                match builtins::in_arg_index(n, &st.fargs) {
+                    Ok(v) => v,
+                    Err(i) => self.dyn_fail(
                         st,
                         ErrorKind::Other,
                         format!("arg({i}): the primitive has {} arguments", st.fargs.len()),
-                    )
+                    ),
                 }
             }
         }

@@ -1450,24 +1450,10 @@ impl Fast {
                 Op::Jn { d, n, x } => r[d as usize] = builtins::jn(r[n as usize], r[x as usize]),
                 Op::Yn { d, n, x } => r[d as usize] = builtins::yn(r[n as usize], r[x as usize]),
                 Op::In { d, a } => {
-                    let i = (r[a as usize] + 0.5) as i64;
-                    r[d as usize] = if i == 0 {
-                        inp.chans.len() as f64
-                    } else if i > 0 {
-                        inp.chans.get(i as usize - 1).copied().unwrap_or(0.0)
-                    } else {
-                        0.0
-                    };
+                    r[d as usize] = builtins::in_arg_index(r[a as usize], inp.chans).unwrap_or(0.0);
                 }
                 Op::Arg { d, a } => {
-                    let i = (r[a as usize] + 0.5) as i64;
-                    r[d as usize] = if i == 0 {
-                        inp.fargs.len() as f64
-                    } else if i > 0 && (i as usize) <= inp.fargs.len() {
-                        inp.fargs[i as usize - 1]
-                    } else {
-                        return None;
-                    };
+                    r[d as usize] = builtins::in_arg_index(r[a as usize], inp.fargs).ok()?;
                 }
                 Op::JumpNotPos { c, to } => {
                     if r[c as usize] <= 0.0 || r[c as usize].is_nan() {
