@@ -136,7 +136,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             pos[3].clone(),
         ),
     };
-    let picture = has_int_field(&vspec);
+    let picture = fenestra_cli::printf::has_int_field(&vspec);
 
     // T·D (None for the two-phase form, whose left matrix multiplies the sky directly).
     let td = match &td_specs {
@@ -176,87 +176,6 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let td = td.map(|t| t.0);
     matrix_form(v_reader, &vspec, td.as_ref(), td_specs.as_ref(), &sky, &o)?;
     Ok(ExitCode::SUCCESS)
-}
-
-/// Whether a name holds a printf integer field (`%d %i %o %x %X`, flags and width allowed).
-fn has_int_field(s: &str) -> bool {
-    find_int_field(s).is_some()
-}
-
-/// Position (start, end) of the first integer field in `s`.
-fn find_int_field(s: &str) -> Option<(usize, usize)> {
-    let b = s.as_bytes();
-    let mut i = 0;
-    while i < b.len() {
-        if b[i] == b'%' {
-            if b.get(i + 1) == Some(&b'%') {
-                i += 2;
-                continue;
-            }
-            let mut j = i + 1;
-            while j < b.len() && b"-+ #0".contains(&b[j]) {
-                j += 1;
-            }
-            while j < b.len() && b[j].is_ascii_digit() {
-                j += 1;
-            }
-            if j < b.len() && b"dioxX".contains(&b[j]) {
-                return Some((i, j + 1));
-            }
-        }
-        i += 1;
-    }
-    None
-}
-
-/// Formats `s` with `n` in its integer field (printf rules for flags `-+ #0` and width;
-/// `%%` becomes `%`).
-fn format_int_field(s: &str, n: usize) -> String {
-    let Some((a, e)) = find_int_field(s) else {
-        return s.replace("%%", "%");
-    };
-    let f = &s[a + 1..e - 1];
-    let conv = s.as_bytes()[e - 1];
-    let flags: String = f.chars().take_while(|c| "-+ #0".contains(*c)).collect();
-    let width: usize = f[flags.len()..].parse().unwrap_or(0);
-    let mut digits = match conv {
-        b'o' => format!("{n:o}"),
-        b'x' => format!("{n:x}"),
-        b'X' => format!("{n:X}"),
-        _ => n.to_string(),
-    };
-    if flags.contains('#') && n != 0 {
-        digits = match conv {
-            b'o' => format!("0{digits}"),
-            b'x' => format!("0x{digits}"),
-            b'X' => format!("0X{digits}"),
-            _ => digits,
-        };
-    }
-    if matches!(conv, b'd' | b'i') {
-        if flags.contains('+') {
-            digits = format!("+{digits}");
-        } else if flags.contains(' ') {
-            digits = format!(" {digits}");
-        }
-    }
-    let field = if digits.len() >= width {
-        digits
-    } else if flags.contains('-') {
-        format!("{digits:<width$}")
-    } else if flags.contains('0') {
-        let sign = digits.starts_with(['+', ' ']);
-        let (p, d) = digits.split_at(usize::from(sign));
-        format!("{p}{}{d}", "0".repeat(width - digits.len()))
-    } else {
-        format!("{digits:>width$}")
-    };
-    format!(
-        "{}{}{}",
-        s[..a].replace("%%", "%"),
-        field,
-        s[e..].replace("%%", "%")
-    )
 }
 
 /// Loads T (XML or matrix) and D, checks their sizes, and returns T·D with the
@@ -663,7 +582,7 @@ fn matrix_form(
     let ncomp = vr.info.ncomp;
     let steps = sky.steps();
     let per_step = match (o.out_spec.as_deref(), steps) {
-        (Some(s), n) if n > 1 && has_int_field(s) => Some(s.to_string()),
+        (Some(s), n) if n > 1 && fenestra_cli::printf::has_int_field(s) => Some(s.to_string()),
         _ => None,
     };
     let left = |vbuf: &[f64], n: usize| -> Result<Planar> {
@@ -703,7 +622,7 @@ fn matrix_form(
             res.steps()
                 .into_par_iter()
                 .try_for_each(|t| -> Result<()> {
-                    let name = format_int_field(&pattern, t);
+                    let name = fenestra_cli::printf::format_int_field(&pattern, t)?;
                     let (mut dest, off) = Dest::open(Some(&name))?;
                     dest.w()
                         .write_all(&header_bytes(o, Some(t), orows, ocols, off))?;
@@ -720,7 +639,7 @@ fn matrix_form(
         return Ok(());
     }
 
-    let out_name = o.out_spec.as_deref().map(|s| format_int_field(s, 0));
+    let out_name = o.out_spec.as_deref().map(|s| fenestra_cli::printf::format_int_field(s, 0)).transpose()?;
     let mut vr = VRows::new(vr)?;
     let nrows = vr.nrows();
     let (orows, ocols) = reshape(nrows, steps, o)?;
@@ -791,7 +710,7 @@ fn picture_form(vspec: &str, td: Option<Planar>, sky: &PackedSky, o: &Opts) -> R
     let per_step = o
         .out_spec
         .as_deref()
-        .filter(|s| steps > 1 && has_int_field(s))
+        .filter(|s| steps > 1 && fenestra_cli::printf::has_int_field(s))
         .map(str::to_string);
     let mut stdout_dest: Option<(Dest, Option<u64>)> = None;
     for t in 0..steps {
@@ -804,7 +723,7 @@ fn picture_form(vspec: &str, td: Option<Planar>, sky: &PackedSky, o: &Opts) -> R
                 continue;
             }
             if cache[r].is_none() {
-                let name = format_int_field(vspec, r);
+                let name = fenestra_cli::printf::format_int_field(vspec, r)?;
                 let mut rd = fenestra_cli::input::open(&name)?;
                 let p = Picture::read(&mut rd, "dctimestep").map_err(|e| anyhow!("{name}: {e}"))?;
                 match &dims {
@@ -856,8 +775,8 @@ fn picture_form(vspec: &str, td: Option<Planar>, sky: &PackedSky, o: &Opts) -> R
         }
         // A picture file named *.exr is written as OpenEXR (one file per time step).
         let exr_name = match (&per_step, o.out_spec.as_deref()) {
-            (Some(p), _) => Some(format_int_field(p, t)),
-            (None, Some(spec)) if steps == 1 => Some(format_int_field(spec, 0)),
+            (Some(p), _) => Some(fenestra_cli::printf::format_int_field(p, t)?),
+            (None, Some(spec)) if steps == 1 => Some(fenestra_cli::printf::format_int_field(spec, 0)?),
             _ => None,
         }
         .filter(|n| fenestra_formats::exr::is_exr_path(n));
@@ -879,7 +798,7 @@ fn picture_form(vspec: &str, td: Option<Planar>, sky: &PackedSky, o: &Opts) -> R
         let enc = Sink::encode(DataFormat::Rgbe, w, 0, &sum);
         match &per_step {
             Some(p) => {
-                let name = format_int_field(p, t);
+                let name = fenestra_cli::printf::format_int_field(p, t)?;
                 let (mut d, _) = Dest::open(Some(&name))?;
                 d.w().write_all(&hb)?;
                 let mut sink = Sink::new(DataFormat::Rgbe, w);
@@ -888,7 +807,7 @@ fn picture_form(vspec: &str, td: Option<Planar>, sky: &PackedSky, o: &Opts) -> R
             }
             None => {
                 if stdout_dest.is_none() {
-                    let name = o.out_spec.as_deref().map(|s| format_int_field(s, 0));
+                    let name = o.out_spec.as_deref().map(|s| fenestra_cli::printf::format_int_field(s, 0)).transpose()?;
                     stdout_dest = Some(Dest::open(name.as_deref())?);
                 }
                 let (d, _) = stdout_dest.as_mut().expect("destination");

@@ -68,9 +68,12 @@ impl Spec {
                     i += 1;
                     continue;
                 }
+                let start = i;
                 while i < b.len() && (b[i].is_ascii_digit() || b[i] == '-' || b[i] == '+') {
                     i += 1;
                 }
+                let flags: String = b[start..i].iter().collect();
+                fenestra_cli::printf::check_width(text, flags.trim_start_matches(['-', '+', '0']))?;
                 match b.get(i) {
                     Some('s') if !has_mod => has_mod = true,
                     Some('d' | 'i' | 'o' | 'x' | 'X') if !has_bin => has_bin = true,
@@ -306,20 +309,35 @@ pub fn partial_path(name: &str) -> PathBuf {
 }
 
 /// An output being written under its partial name.
+/// A target that exists and is not a regular file (a link, pipe or device) is written
+/// through, as Radiance does, and cannot be recovered with `-r`.
 struct PartialFile {
     target: PathBuf,
-    tmp: PathBuf,
+    tmp: Option<PathBuf>,
     w: Option<BufWriter<File>>,
 }
 
 impl PartialFile {
     fn create(target: &str) -> Result<PartialFile> {
+        use fenestra_cli::output::{target_kind, Target};
+        if target_kind(Path::new(target))? == Target::Through {
+            let f = std::fs::OpenOptions::new()
+                .write(true)
+                .truncate(true)
+                .open(target)
+                .with_context(|| format!("cannot open '{target}' for writing"))?;
+            return Ok(PartialFile {
+                target: PathBuf::from(target),
+                tmp: None,
+                w: Some(BufWriter::with_capacity(1 << 16, f)),
+            });
+        }
         let tmp = partial_path(target);
         let f = File::create(&tmp)
             .with_context(|| format!("cannot open '{target}' for writing ({})", tmp.display()))?;
         Ok(PartialFile {
             target: PathBuf::from(target),
-            tmp,
+            tmp: Some(tmp),
             w: Some(BufWriter::with_capacity(1 << 16, f)),
         })
     }
@@ -335,7 +353,7 @@ impl PartialFile {
         f.seek(SeekFrom::End(0))?;
         Ok(PartialFile {
             target: PathBuf::from(target),
-            tmp,
+            tmp: Some(tmp),
             w: Some(BufWriter::with_capacity(1 << 16, f)),
         })
     }
@@ -345,10 +363,15 @@ impl PartialFile {
             let f = w
                 .into_inner()
                 .map_err(|e| anyhow::anyhow!("write error on '{}': {e}", self.target.display()))?;
-            f.sync_all().ok();
+            if self.tmp.is_some() {
+                f.sync_all().ok();
+            }
         }
-        std::fs::rename(&self.tmp, &self.target)
-            .with_context(|| format!("cannot rename output into '{}'", self.target.display()))
+        match self.tmp.take() {
+            Some(tmp) => std::fs::rename(&tmp, &self.target)
+                .with_context(|| format!("cannot rename output into '{}'", self.target.display())),
+            None => Ok(()),
+        }
     }
 }
 
@@ -371,7 +394,9 @@ impl Drop for PartialFile {
     fn drop(&mut self) {
         // an error (not a kill): no partial output is left behind
         if self.w.take().is_some() {
-            let _ = std::fs::remove_file(&self.tmp);
+            if let Some(tmp) = &self.tmp {
+                let _ = std::fs::remove_file(tmp);
+            }
         }
     }
 }
@@ -405,6 +430,9 @@ pub fn examine_partial(plan: &StreamPlan, format: Format) -> Result<Option<Parti
     };
     if name.starts_with('!') {
         bail!("cannot recover output written to a command ({name})");
+    }
+    if fenestra_cli::output::target_kind(Path::new(name))? == fenestra_cli::output::Target::Through {
+        bail!("cannot recover '{name}': it is a link, pipe or device, written through");
     }
     let rs = record_size(plan, format).context("cannot recover ASCII output")?;
     let tmp = partial_path(name);
