@@ -268,7 +268,14 @@ fn read_sky(
     let steps = r.info.ncols;
     let mut rowbuf = vec![0.0; r.info.row_len()];
     let mut rows_v: Vec<Vec<f64>> = Vec::new();
-    let mut sky = r.info.nrows.map(|nr| PackedSky::new(nr, steps));
+    // allocated at once when the file's size vouches for the header's shape (or the shape
+    // is small); a pipe's rows are gathered as they come
+    let small = |nr: usize| (nr as u128) * (r.info.row_len() as u128) <= 1 << 24;
+    let mut sky = r
+        .info
+        .nrows
+        .filter(|&nr| r.size_checked() || small(nr))
+        .map(|nr| PackedSky::new(nr, steps));
     let mut k = 0;
     while r.read_row(&mut rowbuf)? {
         match sky.as_mut() {
@@ -282,6 +289,9 @@ fn read_sky(
         None => {
             if rows > 0 && k != rows {
                 bail!("{shown}: sky has {k} rows (patches), {rows} expected");
+            }
+            if let Some(nr) = r.info.nrows.filter(|&nr| nr != k) {
+                bail!("{shown}: sky has {k} rows but its header says NROWS={nr}");
             }
             let mut s = PackedSky::new(k, steps);
             for (i, row) in rows_v.iter().enumerate() {

@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use fenestra_contrib::calc::{is_zero_constant, parse_params, BinRequest, Bins, CalcDefs};
 use fenestra_contrib::engine::{
-    read_rays, Engine, InFormat, InputRay, Record, RunOptions, Tracked,
+    Engine, InFormat, InputRay, RayInput, Record, RunOptions, Tracked,
 };
 use fenestra_contrib::output::{self, Format, HeaderInfo, ModOut, Spec, Stream};
 use fenestra_trace::{TraceOptions, Tracer};
@@ -232,13 +232,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 n if fenestra_trace::TraceOptions::is_number_option(n) => {
                     o.set_number(n, num(&args, i + 1)?);
                 }
-                "n" => {
-                    let n = num(&args, i + 1)?;
-                    if n < 1.0 {
-                        bail!("bad number of processes ({n})");
-                    }
-                    nproc = n as usize;
-                }
+                "n" => nproc = fenestra_cli::threads::worker_count(num(&args, i + 1)?)?,
                 "c" => count = num(&args, i + 1)?.max(0.0) as usize,
                 "x" => xres = num(&args, i + 1)?.max(0.0) as usize,
                 "y" => yres = num(&args, i + 1)?.max(0.0) as usize,
@@ -403,8 +397,19 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         None
     };
     let stdin = std::io::stdin();
-    let mut rd = std::io::BufReader::with_capacity(1 << 16, stdin.lock());
-    let rays: Vec<InputRay> = read_rays(&mut rd, fin, expect)?;
+    let mut input = RayInput::new(
+        std::io::BufReader::with_capacity(1 << 16, stdin.lock()),
+        fin,
+    );
+    // Rays are read as they are traced (records stream out, flushed where Radiance
+    // flushes), except where the whole input is needed first: bins found by a first pass
+    // (rtcontrib without -bn) and the single sum of -c 0.
+    let buffered = dynamic || count == 0;
+    let rays: Vec<InputRay> = if buffered {
+        input.read_all(expect)?
+    } else {
+        Vec::new()
+    };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(nproc).build()?;
 
     // rtcontrib without -bn: a first pass over the input finds the bins each such
@@ -427,7 +432,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         let mut r = 0;
         while r < nrec {
             let n = 256.min(nrec - r);
-            probe.records(&rays, r, n, &pool)?;
+            probe.records(&rays, 0, r, n, &pool)?;
             r += n;
         }
         for (m, b) in probe.take_bad_bins() {
@@ -570,7 +575,10 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         batches,
     };
     let engine = Engine::new(&tracer, &bins, scene.prims.len(), &tracked, opts);
-    let progress = fenestra_cli::progress::Progress::new(rays.len() as u64, fenestra_cli::prog());
+    let progress = fenestra_cli::progress::Progress::new(
+        expect.unwrap_or(rays.len()) as u64,
+        fenestra_cli::prog(),
+    );
     let write = |rec: &Record, streams: &mut [Stream], err_streams: &mut [Stream]| -> Result<()> {
         for s in streams.iter_mut() {
             s.write_record(fout, rec.scale, |m, b| {
@@ -588,6 +596,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         }
         Ok(())
     };
+    let mut total_rays = rays.len();
     if count == 0 {
         let dummies = rays
             .iter()
@@ -608,7 +617,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             }
         }
         write(&rec, &mut streams, &mut err_streams)?;
-    } else {
+    } else if buffered {
         let nrec = rays.len().div_ceil(count);
         if rays.len() % count != 0 && warnings {
             fenestra_cli::warn("partial accumulation in final record");
@@ -618,7 +627,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         progress.inc(((r * count).min(rays.len())) as u64);
         while r < nrec {
             let n = block.min(nrec - r);
-            let recs = engine.records(&rays, r, n, &pool)?;
+            let recs = engine.records(&rays, 0, r, n, &pool)?;
             for rec in &recs {
                 write(rec, &mut streams, &mut err_streams)?;
             }
@@ -627,6 +636,72 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             progress.inc((hi - lo) as u64);
             r += n;
         }
+    } else {
+        // records streamed in batches; Radiance's flushing: after every -x records unless
+        // -y makes a picture with lines of -x > 1 records, and after a record holding a
+        // dummy (zero-direction) ray
+        let flush_every = if yres > 0 && xres > 1 { 0 } else { xres };
+        let block = (8192 / count).max(32 * nproc).max(1);
+        let skip = done_records as usize * count;
+        let mut seen = 0usize;
+        while seen < skip && input.next_ray()?.is_some() {
+            seen += 1;
+        }
+        progress.inc(seen as u64);
+        let (mut base, mut nextflush) = (seen, flush_every);
+        let mut batch: Vec<InputRay> = Vec::new();
+        let mut partial = false;
+        loop {
+            batch.clear();
+            let mut flush = false;
+            let mut dummy = false;
+            while batch.len() < block * count && expect.is_none_or(|e| base + batch.len() < e) {
+                let Some(ray) = input.next_ray()? else {
+                    break;
+                };
+                dummy |= ray.dir == fenestra_trace::DVec3::ZERO;
+                batch.push(ray);
+                if (base + batch.len()) % count == 0 {
+                    if dummy {
+                        flush = true;
+                        nextflush = flush_every;
+                        break;
+                    }
+                    if flush_every > 0 {
+                        nextflush -= 1;
+                        if nextflush == 0 {
+                            flush = true;
+                            nextflush = flush_every;
+                            break;
+                        }
+                    }
+                }
+            }
+            if batch.is_empty() {
+                break;
+            }
+            partial = (base + batch.len()) % count != 0;
+            let first = base / count;
+            let n = batch.len().div_ceil(count);
+            let recs = engine.records(&batch, base, first, n, &pool)?;
+            for rec in &recs {
+                write(rec, &mut streams, &mut err_streams)?;
+            }
+            if flush {
+                for s in streams.iter_mut().chain(err_streams.iter_mut()) {
+                    s.flush()?;
+                }
+            }
+            progress.inc(batch.len() as u64);
+            base += batch.len();
+            if partial || expect.is_some_and(|e| base >= e) {
+                break;
+            }
+        }
+        if partial && warnings {
+            fenestra_cli::warn("partial accumulation in final record");
+        }
+        total_rays = base;
     }
     progress.finish();
     if warnings {
@@ -637,8 +712,11 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     for s in streams.into_iter().chain(err_streams) {
         s.finish()?;
     }
+    for msg in input.take_warnings() {
+        fenestra_cli::warn(msg);
+    }
     if let Some(e) = expect {
-        if rays.len() < e {
+        if total_rays < e {
             bail!("unexpected EOF on input");
         }
     }

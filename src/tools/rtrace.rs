@@ -1,6 +1,6 @@
 //! rtrace: trace rays (or compute irradiance at points) in a scene.
 
-use std::io::{BufRead, Read, Write};
+use std::io::Write;
 use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
@@ -77,7 +77,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let mut outspec = "v".to_string();
     let (mut fin, mut fout) = (Fmt::Ascii, Fmt::Ascii);
     let (mut xres, mut yres, mut nproc) = (0usize, 0usize, 1usize);
-    let mut aa = 0.1;
+    let mut aa: Option<f64> = None;
     let mut files = Vec::new();
     let mut i = 1;
     while i < args.len() {
@@ -97,7 +97,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         } else if let Some(v) = toggle(a, "u", false) {
             let _ = v;
         } else if let Some(v) = toggle(a, "w", true) {
-            let _ = v;
+            fenestra_cli::set_warnings(v);
         } else if a == "-full" {
             o.full = true;
         } else if a == "-v" {
@@ -119,7 +119,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 }
                 "dt" => o.dt = num(&args, i + 1)?,
                 "dp" => {}
-                "aa" => aa = num(&args, i + 1)?,
+                "aa" => aa = Some(num(&args, i + 1)?),
                 "as" => o.asamp = num(&args, i + 1)?.max(0.0) as u32,
                 "ar" | "aw" => {
                     num(&args, i + 1)?;
@@ -130,7 +130,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 }
                 "x" => xres = num(&args, i + 1)?.max(0.0) as usize,
                 "y" => yres = num(&args, i + 1)?.max(0.0) as usize,
-                "n" => nproc = num(&args, i + 1)?.max(1.0) as usize,
+                "n" => nproc = fenestra_cli::threads::worker_count(num(&args, i + 1)?)?,
                 "av" => {
                     o.av = [num(&args, i + 1)?, num(&args, i + 2)?, num(&args, i + 3)?];
                     i += 2;
@@ -161,8 +161,11 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             fenestra_cli::prog()
         );
     }
-    if aa > 0.0 {
-        fenestra_cli::warn(format!("-aa {aa}: the irradiance cache is not supported; computing as with -aa 0 (pure Monte Carlo)"));
+    // the irradiance cache is not implemented: a warning when asked for, a note with -v
+    match aa {
+        Some(a) if a > 0.0 => fenestra_cli::warn(format!("-aa {a}: the irradiance cache is not supported; computing as with -aa 0 (pure Monte Carlo)")),
+        _ if verbose => eprintln!("{}: no irradiance cache (-aa 0): indirect light by pure Monte Carlo", fenestra_cli::prog()),
+        _ => {}
     }
     for c in outspec.chars() {
         if !"odvVwlLpnN".contains(c) {
@@ -204,7 +207,6 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     if tracer.source_count() == 0 && !outspec.chars().all(|c| "odlLpnN".contains(c)) {
         fenestra_cli::warn("no light sources found");
     }
-    let rays = read_rays(fin)?;
     let expect = if yres > 0 { xres.max(1) * yres } else { 0 };
     let out = std::io::stdout();
     let mut w = std::io::BufWriter::with_capacity(1 << 16, out.lock());
@@ -223,118 +225,193 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         }
         w.write_all(h.as_bytes())?;
     }
-    let n = if expect > 0 {
-        rays.len().min(expect)
-    } else {
-        rays.len()
-    };
+    // Radiance's flushing: every -x records unless -y makes a picture of -x > 1 records a
+    // line; a ray with a zero direction flushes too
+    let flush_every = if yres == 0 || xres <= 1 { xres } else { 0 };
+    if flush_every > 0 {
+        w.flush()?;
+    }
     let pool = rayon::ThreadPoolBuilder::new().num_threads(nproc).build()?;
-    let progress = fenestra_cli::progress::Progress::new(n as u64, "rtrace");
+    let progress = fenestra_cli::progress::Progress::new(expect as u64, "rtrace");
     let mut base = tracer.direct_state();
-    let (mut start, mut wave) = (0usize, 0usize);
-    while start < n {
-        let width = if thresholding {
-            wave_width(wave)
+    let wants_hit = outspec.chars().any(|c| "lLpnN".contains(c));
+    let record = |k: usize, (org, dir): (DVec3, DVec3), st: &mut fenestra_trace::DirectState| {
+        let mut rec = Vec::new();
+        let hit = if wants_hit {
+            Some(tracer.first_hit(org, dir))
         } else {
-            CHUNK
+            None
         };
-        let end = (start + width * block).min(n);
-        let record = |k: usize, st: &mut fenestra_trace::DirectState| {
-            let (org, dir) = rays[k];
-            let mut rec = Vec::new();
-            let hit = if outspec.chars().any(|c| "lLpnN".contains(c)) {
-                Some(tracer.first_hit(org, dir))
-            } else {
-                None
+        for c in outspec.chars() {
+            match c {
+                'o' => rec.extend(org.to_array()),
+                'd' => rec.extend(dir.normalize_or_zero().to_array()),
+                'v' | 'V' => {
+                    let v = if dir == DVec3::ZERO {
+                        [0.0; 3]
+                    } else if irr {
+                        // Radiance's -I point: 1e-4 along the normal
+                        let n = dir.normalize_or_zero();
+                        let q = Tracer::rtrace_irradiance_point(org, n);
+                        tracer.irradiance_with(st, k as u64, q, n)
+                    } else if irr_hit {
+                        tracer.irradiance_at_hit_with(st, k as u64, org, dir)
+                    } else {
+                        tracer.radiance_with(st, k as u64, org, dir)
+                    };
+                    rec.extend(v);
+                }
+                'w' => rec.push(1.0),
+                'l' | 'L' => rec.push(hit.map_or(0.0, |h| h.t)),
+                'p' => rec.extend(hit.map_or([0.0; 3], |h| h.point.to_array())),
+                _ => rec.extend(hit.map_or([0.0; 3], |h| h.normal.to_array())),
+            }
+        }
+        rec
+    };
+    // Rays are read and traced in batches; a batch ends early where Radiance flushes. The
+    // thresholding waves end on batch ends: a full batch is a whole number of the widest
+    // waves, so without flushes the waves are those of one pass over all rays.
+    let batch_max = if thresholding {
+        64 * WAVE_MAX * block
+    } else {
+        CHUNK * 8
+    };
+    let stdin = std::io::stdin();
+    let mut reader = fenestra_cli::rays::RayReader::new(
+        std::io::BufReader::with_capacity(1 << 16, stdin.lock()),
+        match fin {
+            Fmt::Ascii => fenestra_cli::rays::RayFormat::Ascii,
+            Fmt::Float => fenestra_cli::rays::RayFormat::Float,
+            Fmt::Double => fenestra_cli::rays::RayFormat::Double,
+        },
+    );
+    let (mut k0, mut wave, mut nextflush) = (0usize, 0usize, flush_every);
+    let mut bad_rays = 0usize;
+    let mut batch: Vec<(DVec3, DVec3)> = Vec::new();
+    loop {
+        batch.clear();
+        let mut flush = false;
+        while batch.len() < batch_max && (expect == 0 || k0 + batch.len() < expect) {
+            let Some((org, dir)) = reader.next_ray()? else {
+                break;
             };
-            for c in outspec.chars() {
-                match c {
-                    'o' => rec.extend(org.to_array()),
-                    'd' => rec.extend(dir.normalize_or_zero().to_array()),
-                    'v' | 'V' => {
-                        let v = if dir == DVec3::ZERO {
-                            [0.0; 3]
-                        } else if irr {
-                            // Radiance's -I point: 1e-4 along the normal
-                            let n = dir.normalize_or_zero();
-                            let q = Tracer::rtrace_irradiance_point(org, n);
-                            tracer.irradiance_with(st, k as u64, q, n)
-                        } else if irr_hit {
-                            tracer.irradiance_at_hit_with(st, k as u64, org, dir)
-                        } else {
-                            tracer.radiance_with(st, k as u64, org, dir)
-                        };
-                        rec.extend(v);
-                    }
-                    'w' => rec.push(1.0),
-                    'l' | 'L' => rec.push(hit.map_or(0.0, |h| h.t)),
-                    'p' => rec.extend(hit.map_or([0.0; 3], |h| h.point.to_array())),
-                    _ => rec.extend(hit.map_or([0.0; 3], |h| h.normal.to_array())),
-                }
+            let (org, dir) = (DVec3::from(org), DVec3::from(dir));
+            if !(org.is_finite() && dir.is_finite()) {
+                // answered with zeros (and a warning), never traced into a NaN
+                bad_rays += 1;
+                batch.push((DVec3::ZERO, DVec3::ZERO));
+                continue;
             }
-            rec
-        };
-        let blocks: Vec<(Vec<Vec<f64>>, fenestra_trace::DirectState)> = pool.install(|| {
-            (start..end)
-                .step_by(block)
-                .collect::<Vec<_>>()
-                .into_par_iter()
-                .map(|b| {
-                    let mut st = base.fork();
-                    let recs = (b..(b + block).min(end))
-                        .map(|k| record(k, &mut st))
-                        .collect();
-                    (recs, st)
-                })
-                .collect()
-        });
-        let (vals, states): (Vec<Vec<Vec<f64>>>, Vec<fenestra_trace::DirectState>) =
-            blocks.into_iter().unzip();
-        if thresholding {
-            // all of a wave at once: the blocks' states are dropped before their changes
-            // are applied, so the cache cells they shared are not copied
-            base.merge(states);
-        }
-        let vals = vals.into_iter().flatten();
-        for rec in vals {
-            match fout {
-                Fmt::Ascii => {
-                    let mut s = String::new();
-                    for v in &rec {
-                        s.push_str(&format!("{}\t", fmt_e(*v)));
-                    }
-                    s.push('\n');
-                    w.write_all(s.as_bytes())?;
-                }
-                Fmt::Float => {
-                    for v in &rec {
-                        w.write_all(&(*v as f32).to_ne_bytes())?;
-                    }
-                }
-                Fmt::Double => {
-                    for v in &rec {
-                        w.write_all(&v.to_ne_bytes())?;
-                    }
+            batch.push((org, dir));
+            if dir == DVec3::ZERO {
+                flush = true;
+                nextflush = flush_every;
+                break;
+            }
+            if flush_every > 0 {
+                nextflush -= 1;
+                if nextflush == 0 {
+                    flush = true;
+                    nextflush = flush_every;
+                    break;
                 }
             }
         }
-        progress.inc((end - start) as u64);
-        start = end;
-        wave += 1;
+        if batch.is_empty() {
+            break;
+        }
+        let n = batch.len();
+        let mut start = 0usize;
+        while start < n {
+            let width = if thresholding {
+                wave_width(wave)
+            } else {
+                CHUNK
+            };
+            let end = (start + width * block).min(n);
+            let blocks: Vec<(Vec<Vec<f64>>, fenestra_trace::DirectState)> = pool.install(|| {
+                (start..end)
+                    .step_by(block)
+                    .collect::<Vec<_>>()
+                    .into_par_iter()
+                    .map(|b| {
+                        let mut st = base.fork();
+                        let recs = (b..(b + block).min(end))
+                            .map(|k| record(k0 + k, batch[k], &mut st))
+                            .collect();
+                        (recs, st)
+                    })
+                    .collect()
+            });
+            let (vals, states): (Vec<Vec<Vec<f64>>>, Vec<fenestra_trace::DirectState>) =
+                blocks.into_iter().unzip();
+            if thresholding {
+                // all of a wave at once: the blocks' states are dropped before their changes
+                // are applied, so the cache cells they shared are not copied
+                base.merge(states);
+            }
+            for rec in vals.into_iter().flatten() {
+                write_record(&mut w, fout, &rec)?;
+            }
+            progress.inc((end - start) as u64);
+            start = end;
+            wave += 1;
+        }
+        k0 += n;
+        if flush {
+            w.flush()?;
+        }
+        if expect > 0 && k0 >= expect {
+            break;
+        }
     }
     progress.finish();
     w.flush()?;
+    if let Some(msg) = reader.take_warning() {
+        fenestra_cli::warn(msg);
+    }
+    if bad_rays > 0 {
+        fenestra_cli::warn(format!(
+            "{bad_rays} input ray(s) with a value that is not finite (nan, inf) answered with zeros"
+        ));
+    }
     if verbose {
         eprintln!(
-            "{}: {} rays traced for {n} input records",
+            "{}: {} rays traced for {k0} input records",
             fenestra_cli::prog(),
             tracer.rays_traced()
         );
     }
-    if expect > 0 && rays.len() < expect {
+    if expect > 0 && k0 < expect {
         bail!("unexpected EOF on input");
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Writes one record's values in the output format.
+fn write_record(w: &mut impl Write, fout: Fmt, rec: &[f64]) -> Result<()> {
+    match fout {
+        Fmt::Ascii => {
+            let mut s = String::new();
+            for v in rec {
+                s.push_str(&format!("{}\t", fmt_e(*v)));
+            }
+            s.push('\n');
+            w.write_all(s.as_bytes())?;
+        }
+        Fmt::Float => {
+            for v in rec {
+                w.write_all(&(*v as f32).to_ne_bytes())?;
+            }
+        }
+        Fmt::Double => {
+            for v in rec {
+                w.write_all(&v.to_ne_bytes())?;
+            }
+        }
+    }
+    Ok(())
 }
 
 /// C's `%e` (6 digits after the point, exponent with sign and at least two digits).
@@ -346,50 +423,6 @@ fn fmt_e(v: f64) -> String {
     let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
     let e: i32 = e.parse().unwrap_or(0);
     format!("{m}e{}{:02}", if e < 0 { '-' } else { '+' }, e.abs())
-}
-
-fn read_rays(fmt: Fmt) -> Result<Vec<(DVec3, DVec3)>> {
-    let stdin = std::io::stdin();
-    let mut rd = std::io::BufReader::with_capacity(1 << 16, stdin.lock());
-    let mut vals: Vec<f64> = Vec::new();
-    match fmt {
-        Fmt::Ascii => {
-            let mut line = String::new();
-            'outer: loop {
-                line.clear();
-                if rd.read_line(&mut line)? == 0 {
-                    break;
-                }
-                for wd in line.split_whitespace() {
-                    match fenestra_cli::opts::parse_real(wd) {
-                        Some(v) => vals.push(v),
-                        None => break 'outer,
-                    }
-                }
-            }
-        }
-        Fmt::Float | Fmt::Double => {
-            let mut bytes = Vec::new();
-            rd.read_to_end(&mut bytes)?;
-            if fmt == Fmt::Float {
-                vals.extend(
-                    bytes
-                        .chunks_exact(4)
-                        .map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]]) as f64),
-                );
-            } else {
-                vals.extend(
-                    bytes
-                        .chunks_exact(8)
-                        .map(|c| f64::from_ne_bytes(c.try_into().unwrap_or([0; 8]))),
-                );
-            }
-        }
-    }
-    Ok(vals
-        .chunks_exact(6)
-        .map(|c| (DVec3::new(c[0], c[1], c[2]), DVec3::new(c[3], c[4], c[5])))
-        .collect())
 }
 
 #[cfg(test)]

@@ -11,6 +11,8 @@ pub mod output;
 pub mod printf;
 pub mod progress;
 pub mod raypath;
+pub mod rays;
+pub mod threads;
 mod run;
 
-pub use run::{command_line, main_with, prog, set_prog, warn, Exit};
+pub use run::{command_line, main_with, prog, set_prog, set_warnings, warn, Exit};

@@ -4,6 +4,12 @@ use std::process::ExitCode;
 use std::sync::OnceLock;
 
 static PROG: OnceLock<String> = OnceLock::new();
+static WARNINGS: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(true);
+
+/// Turns warnings on or off (Radiance's `-w`).
+pub fn set_warnings(on: bool) {
+    WARNINGS.store(on, std::sync::atomic::Ordering::Relaxed);
+}
 
 /// A request to end the program quietly with the given status (e.g. after `--help`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -33,6 +39,9 @@ pub fn prog() -> &'static str {
 
 /// Prints `prog: warning - msg` on stderr, as Radiance tools do.
 pub fn warn(msg: impl std::fmt::Display) {
+    if !WARNINGS.load(std::sync::atomic::Ordering::Relaxed) {
+        return;
+    }
     eprintln!("{}: warning - {}", prog(), msg);
 }
 

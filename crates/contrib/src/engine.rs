@@ -13,15 +13,7 @@ use rayon::prelude::*;
 use crate::calc::Bins;
 
 /// Input data format (`-fi`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum InFormat {
-    /// Text: six numbers per ray.
-    Ascii,
-    /// Six 32-bit floats.
-    Float,
-    /// Six 64-bit floats.
-    Double,
-}
+pub use fenestra_cli::rays::RayFormat as InFormat;
 
 /// One input ray: origin and direction (with `-I`: point and surface normal).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -32,72 +24,65 @@ pub struct InputRay {
     pub dir: DVec3,
 }
 
-/// Reads rays until the input ends, a word is not a number, or `limit` rays were read.
-/// A partial final ray is dropped.
-pub fn read_rays(
-    rd: &mut dyn BufRead,
-    fmt: InFormat,
-    limit: Option<usize>,
-) -> Result<Vec<InputRay>> {
-    let mut rays = Vec::new();
-    let full = |rays: &Vec<InputRay>| limit.is_some_and(|l| rays.len() >= l);
-    let mut vals: Vec<f64> = Vec::with_capacity(6);
-    let push = |vals: &mut Vec<f64>, rays: &mut Vec<InputRay>| {
-        if vals.len() == 6 {
-            rays.push(InputRay {
-                org: DVec3::new(vals[0], vals[1], vals[2]),
-                dir: DVec3::new(vals[3], vals[4], vals[5]),
-            });
-            vals.clear();
-        }
-    };
-    match fmt {
-        InFormat::Ascii => {
-            let mut line = String::new();
-            'outer: while !full(&rays) {
-                line.clear();
-                if rd.read_line(&mut line)? == 0 {
-                    break;
-                }
-                for wd in line.split_whitespace() {
-                    match fenestra_cli::opts::parse_real(wd) {
-                        Some(v) => vals.push(v),
-                        None => break 'outer,
-                    }
-                    push(&mut vals, &mut rays);
-                    if full(&rays) {
-                        break 'outer;
-                    }
-                }
-            }
-        }
-        InFormat::Float | InFormat::Double => {
-            let size = if fmt == InFormat::Float { 4 } else { 8 };
-            let mut rec = vec![0u8; 6 * size];
-            while !full(&rays) {
-                let mut got = 0;
-                while got < rec.len() {
-                    let n = rd.read(&mut rec[got..])?;
-                    if n == 0 {
-                        break;
-                    }
-                    got += n;
-                }
-                if got < rec.len() {
-                    break;
-                }
-                for c in rec.chunks_exact(size) {
-                    vals.push(if size == 4 {
-                        f32::from_ne_bytes([c[0], c[1], c[2], c[3]]) as f64
-                    } else {
-                        f64::from_ne_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]])
-                    });
-                }
-                push(&mut vals, &mut rays);
-            }
+/// Reads input rays one at a time: a ray with a value that is not finite becomes a dummy
+/// ray (zero direction, no contribution) and is counted for a warning.
+pub struct RayInput<R: BufRead> {
+    reader: fenestra_cli::rays::RayReader<R>,
+    /// Rays replaced by dummies because a value was not finite.
+    pub bad: u64,
+}
+
+impl<R: BufRead> RayInput<R> {
+    /// Reads rays of format `fmt` from `rd`.
+    pub fn new(rd: R, fmt: InFormat) -> Self {
+        RayInput {
+            reader: fenestra_cli::rays::RayReader::new(rd, fmt),
+            bad: 0,
         }
     }
-    Ok(rays)
+
+    /// The next ray (`None` at the end of input or where a word is not a number).
+    pub fn next_ray(&mut self) -> Result<Option<InputRay>> {
+        let Some(r) = self.reader.next_ray()? else {
+            return Ok(None);
+        };
+        if !fenestra_cli::rays::finite(&r) {
+            self.bad += 1;
+            return Ok(Some(InputRay {
+                org: DVec3::ZERO,
+                dir: DVec3::ZERO,
+            }));
+        }
+        Ok(Some(InputRay {
+            org: DVec3::from(r.0),
+            dir: DVec3::from(r.1),
+        }))
+    }
+
+    /// Reads up to `limit` rays (all when `None`).
+    pub fn read_all(&mut self, limit: Option<usize>) -> Result<Vec<InputRay>> {
+        let mut rays = Vec::new();
+        while limit.is_none_or(|l| rays.len() < l) {
+            match self.next_ray()? {
+                Some(r) => rays.push(r),
+                None => break,
+            }
+        }
+        Ok(rays)
+    }
+
+    /// Warnings about the input (where it stopped, rays that were not finite), once.
+    pub fn take_warnings(&mut self) -> Vec<String> {
+        let mut w: Vec<String> = self.reader.take_warning().into_iter().collect();
+        if self.bad > 0 {
+            w.push(format!(
+                "{} input ray(s) with a value that is not finite (nan, inf) taken as dummy rays",
+                self.bad
+            ));
+            self.bad = 0;
+        }
+        w
+    }
 }
 
 /// A tracked modifier as the engine sees it.
@@ -412,10 +397,13 @@ impl<'a> Engine<'a> {
         Ok(())
     }
 
-    /// Computes records `first..first+n` of `rays` (`-c N ≥ 1`), in parallel, in order.
+    /// Computes records `first..first+n` (`-c N ≥ 1`), in parallel, in order; `rays[0]`
+    /// is input ray number `base` (records are numbered over the whole input, so a
+    /// stream traced in batches gets the same records as one pass).
     pub fn records(
         &self,
         rays: &[InputRay],
+        base: usize,
         first: usize,
         n: usize,
         pool: &rayon::ThreadPool,
@@ -433,15 +421,18 @@ impl<'a> Engine<'a> {
                     || self.scratch(),
                     |scratch, r| {
                         let acc = if batches > 1 {
-                            let ray = rays[r];
+                            let ray = rays[r - base];
                             self.accumulate(
                                 (0..batches).map(|j| ((r * batches + j) as u64, ray)),
                                 scratch,
                             )
                         } else {
                             let lo = r * c;
-                            let hi = (lo + c).min(rays.len());
-                            self.accumulate((lo..hi).map(|k| (k as u64, rays[k])), scratch)
+                            let hi = (lo + c).min(base + rays.len());
+                            self.accumulate(
+                                (lo..hi).map(|k| (k as u64, rays[k - base])),
+                                scratch,
+                            )
                         };
                         self.finish(acc, false)
                     },

@@ -659,12 +659,38 @@ impl Stream {
             .name
             .clone()
             .unwrap_or_else(|| "standard output".into());
-        self.w()
-            .write_all(&buf)
-            .with_context(|| format!("write error on '{name}'"))?;
+        if let Err(e) = self.w().write_all(&buf) {
+            if let Dest::Cmd(child, _, cmd) = &mut self.dest {
+                // a command that ended without reading its input: say so (a closed pipe
+                // would otherwise end the run without a message)
+                let status = child
+                    .wait()
+                    .map(|st| st.to_string())
+                    .unwrap_or_else(|_| "unknown status".into());
+                bail!("output command '{cmd}' stopped reading its input ({status}): {e}");
+            }
+            return Err(e).with_context(|| format!("write error on '{name}'"));
+        }
         self.buf = buf;
         self.buf.clear();
         Ok(())
+    }
+
+    /// Writes out what is buffered and flushes the destination (a record boundary where
+    /// Radiance flushes: `-x` records, a dummy ray).
+    pub fn flush(&mut self) -> Result<()> {
+        self.flush_buf()?;
+        if matches!(self.dest, Dest::Exr(_)) {
+            return Ok(());
+        }
+        let name = self
+            .plan
+            .name
+            .clone()
+            .unwrap_or_else(|| "standard output".into());
+        self.w()
+            .flush()
+            .with_context(|| format!("write error on '{name}'"))
     }
 
     /// Writes one record; `value(m, b)` gives the RGB sums of modifier `m`, bin `b`,
@@ -750,8 +776,10 @@ impl Stream {
                 )?;
             }
             Dest::Cmd(mut child, mut w, cmd) => {
-                w.flush()
-                    .with_context(|| format!("write error on output command '{cmd}'"))?;
+                if let Err(e) = w.flush() {
+                    let st = child.wait().map(|st| st.to_string()).unwrap_or_default();
+                    bail!("output command '{cmd}' stopped reading its input ({st}): {e}");
+                }
                 drop(w);
                 let st = child.wait()?;
                 if !st.success() {

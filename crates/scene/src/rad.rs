@@ -155,7 +155,7 @@ impl Parser {
             })
         };
         let ns = count(w, "string")?;
-        let mut sargs = Vec::with_capacity(ns);
+        let mut sargs = Vec::with_capacity(ns.min(64)); // counts are checked by what follows
         for k in 0..ns {
             sargs.push(word(
                 w,
@@ -163,7 +163,7 @@ impl Parser {
             )?);
         }
         let ni = count(w, "integer")?;
-        let mut iargs = Vec::with_capacity(ni);
+        let mut iargs = Vec::with_capacity(ni.min(64));
         for k in 0..ni {
             iargs.push(word(
                 w,
@@ -171,7 +171,7 @@ impl Parser {
             )?);
         }
         let nr = count(w, "real")?;
-        let mut rargs = Vec::with_capacity(nr);
+        let mut rargs = Vec::with_capacity(nr.min(64));
         for k in 0..nr {
             let s = word(w, &format!("real argument {} of {nr} of {what}", k + 1))?;
             let v = parse_real(&s).ok_or_else(|| {

@@ -313,7 +313,7 @@ impl Xformer<'_> {
             word(&format!("the string-argument count of {what}"))?,
             "string",
         )?;
-        let mut sargs = Vec::with_capacity(ns);
+        let mut sargs = Vec::with_capacity(ns.min(64)); // counts are checked by what follows
         for _ in 0..ns {
             sargs.push(word(&format!("a string argument of {what}"))?);
         }
@@ -321,12 +321,12 @@ impl Xformer<'_> {
             word(&format!("the integer-argument count of {what}"))?,
             "integer",
         )?;
-        let mut iargs = Vec::with_capacity(ni);
+        let mut iargs = Vec::with_capacity(ni.min(64));
         for _ in 0..ni {
             iargs.push(word(&format!("an integer argument of {what}"))?);
         }
         let nr = to_count(word(&format!("the real-argument count of {what}"))?, "real")?;
-        let mut rargs = Vec::with_capacity(nr);
+        let mut rargs = Vec::with_capacity(nr.min(64));
         for _ in 0..nr {
             let s = word(&format!("a real argument of {what}"))?;
             rargs.push(parse_real(&s).ok_or_else(|| {

@@ -7,8 +7,9 @@ use anyhow::{bail, Context, Result};
 use super::{ascii, rgbe, DataFormat, NATIVE_BIG_ENDIAN};
 use crate::header::Header;
 
-/// Largest number of values per row accepted (NCOLS × NCOMP).
-const MAX_ROW_VALUES: usize = 1 << 30;
+/// Largest number of values per row accepted (NCOLS × NCOMP): 2^25 values (a 256 MiB row
+/// buffer) hold a year of one-minute sky columns 60 times over.
+const MAX_ROW_VALUES: usize = 1 << 25;
 
 /// What a matrix header says about its data.
 #[derive(Debug, Clone, PartialEq)]
@@ -92,9 +93,16 @@ pub struct MatrixReader {
     bytes: Vec<u8>,
     pixels: Vec<[u8; 4]>,
     tok: Vec<u8>,
+    size_checked: bool,
 }
 
 impl MatrixReader {
+    /// Whether the header's shape was checked against the size of the file (a regular
+    /// file): its rows can be allocated at once. Data from a pipe may stop short.
+    pub fn size_checked(&self) -> bool {
+        self.size_checked
+    }
+
     /// Opens `name`: `-` for stdin, `!command` for a command's output, else a file.
     /// For a file in a binary format without `NROWS=`, the row count is inferred from
     /// its size; a size too small for `NROWS=` is an error at once.
@@ -207,16 +215,36 @@ impl MatrixReader {
             bytes: Vec::new(),
             pixels: Vec::new(),
             tok: Vec::new(),
+            size_checked: false,
         })
     }
 
     /// Checks (and for missing NROWS, infers) the row count of binary data from the
     /// file size `len` (header included).
     fn check_size(&mut self, len: u64) -> Result<()> {
+        let data = len.saturating_sub(self.info.header.byte_len);
+        self.size_checked = true;
         let Some(vs) = self.info.format.value_size() else {
+            if self.info.format != DataFormat::Ascii {
+                return Ok(());
+            }
+            // a text value takes at least one character and one separator
+            let most = data / 2 + 1;
+            let need = self.info.nrows.unwrap_or(1) as u128 * self.info.row_len() as u128;
+            if need > most as u128 {
+                bail!(
+                    "{}: truncated ascii data: header says {}NCOLS={} NCOMP={} ({} values) but the file's {} bytes hold at most {}",
+                    self.name,
+                    self.info.nrows.map_or(String::new(), |n| format!("NROWS={n} ")),
+                    self.info.ncols,
+                    self.info.ncomp,
+                    need,
+                    data,
+                    most
+                );
+            }
             return Ok(());
         };
-        let data = len.saturating_sub(self.info.header.byte_len);
         let row_bytes = (self.info.row_len() * vs) as u64;
         match self.info.nrows {
             None => {

@@ -1,0 +1,33 @@
+//! The worker count of `-n N`: at least one, at most the machine's cores (more threads
+//! than cores cannot help, and results are the same for any count).
+
+use anyhow::{bail, Result};
+
+/// Threads for a request of `n` processes: an error below 1, capped at the cores
+/// available with a warning.
+pub fn worker_count(n: f64) -> Result<usize> {
+    if !(n >= 1.0) {
+        bail!("-n {n}: illegal number of processes (at least 1)");
+    }
+    let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+    if n > cores as f64 {
+        crate::warn(format!(
+            "-n {n}: more processes than the {cores} core(s) here; using {cores} (the output is the same for any -n)"
+        ));
+        return Ok(cores);
+    }
+    Ok(n as usize)
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn bounds() {
+        assert!(super::worker_count(0.0).is_err());
+        assert!(super::worker_count(-1.0).is_err());
+        assert!(super::worker_count(f64::NAN).is_err());
+        assert_eq!(super::worker_count(1.0).unwrap(), 1);
+        let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+        assert_eq!(super::worker_count(1e9).unwrap(), cores);
+    }
+}
