@@ -475,7 +475,8 @@ fn run_parallel<'c>(
             let (dtx, drx) = sync_channel::<Done>(2);
             to_workers.push(btx);
             from_workers.push(drx);
-            sc.spawn(move || {
+            let worker = std::thread::Builder::new().stack_size(fenestra_cli::threads::STACK_BYTES);
+            worker.spawn_scoped(sc, move || {
                 let mut ev = mk();
                 while let Ok(b) = brx.recv() {
                     let done = match b {
@@ -491,7 +492,7 @@ fn run_parallel<'c>(
                         break;
                     }
                 }
-            });
+            })?;
         }
         sc.spawn(move || {
             let mut carry = Vec::new();

@@ -410,7 +410,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     } else {
         Vec::new()
     };
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(nproc).build()?;
+    let pool = fenestra_cli::threads::pool(nproc)?;
 
     // rtcontrib without -bn: a first pass over the input finds the bins each such
     // modifier reaches (rays are seeded by index, so the second pass meets the same ones)

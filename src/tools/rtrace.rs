@@ -231,7 +231,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     if flush_every > 0 {
         w.flush()?;
     }
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(nproc).build()?;
+    let pool = fenestra_cli::threads::pool(nproc)?;
     let progress = fenestra_cli::progress::Progress::new(expect as u64, "rtrace");
     let mut base = tracer.direct_state();
     let wants_hit = outspec.chars().any(|c| "lLpnN".contains(c));

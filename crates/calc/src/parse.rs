@@ -13,6 +13,31 @@ pub struct SyntaxError {
     pub pos: Pos,
 }
 
+/// The deepest expression accepted (nesting of parentheses, calls and `^`, and the length
+/// of a chain of `+`/`*` terms, which the tree holds as nesting): deeper input is a syntax
+/// error rather than a stack overflow. The tools parse, compile and evaluate on threads
+/// with stacks sized for it (`fenestra_cli::threads::STACK_BYTES`).
+pub const MAX_DEPTH: usize = 50_000;
+
+/// Depth of an expression tree (without recursion).
+pub fn depth(e: &Expr) -> usize {
+    let mut most = 0;
+    let mut todo = vec![(e, 1usize)];
+    while let Some((e, d)) = todo.pop() {
+        most = most.max(d);
+        match e {
+            Expr::Num(_) | Expr::Name(..) | Expr::Chan(..) => {}
+            Expr::Call(_, args, _) => todo.extend(args.iter().map(|a| (a, d + 1))),
+            Expr::Neg(a) => todo.push((a, d + 1)),
+            Expr::Bin(_, a, b) => {
+                todo.push((a, d + 1));
+                todo.push((b, d + 1));
+            }
+        }
+    }
+    most
+}
+
 /// Parses a whole source into definitions.
 pub fn parse_defs(text: &str, src: u32) -> Result<Vec<Def>, SyntaxError> {
     let mut p = Parser::new(text, src);
@@ -44,6 +69,7 @@ pub fn parse_defs(text: &str, src: u32) -> Result<Vec<Def>, SyntaxError> {
 pub fn parse_expr(text: &str, src: u32) -> Result<Expr, SyntaxError> {
     let mut p = Parser::new(text, src);
     let e = p.e1()?;
+    p.check_depth(&e)?;
     p.skip_ws()?;
     if p.peek().is_some() {
         return Err(p.err("unexpected character"));
@@ -52,6 +78,7 @@ pub fn parse_expr(text: &str, src: u32) -> Result<Expr, SyntaxError> {
 }
 
 struct Parser {
+    nest: usize,
     chars: Vec<char>,
     i: usize,
     line: u32,
@@ -79,6 +106,7 @@ fn normalise_name(s: String) -> String {
 impl Parser {
     fn new(text: &str, src: u32) -> Self {
         Parser {
+            nest: 0,
             chars: text.chars().collect(),
             i: 0,
             line: 1,
@@ -207,6 +235,7 @@ impl Parser {
         };
         self.bump();
         let body = self.e1()?;
+        self.check_depth(&body)?;
         Ok(Def {
             lhs,
             constant,
@@ -229,8 +258,37 @@ impl Parser {
         Ok(v as u32)
     }
 
+    /// A tree deeper than [`MAX_DEPTH`] is an error.
+    fn check_depth(&self, e: &Expr) -> Result<(), SyntaxError> {
+        if depth(e) > MAX_DEPTH {
+            return Err(self.err(&format!(
+                "expression too deep (more than {MAX_DEPTH} levels of nesting or chained terms)"
+            )));
+        }
+        Ok(())
+    }
+
+    /// Enters one nesting level (parentheses, arguments, `^`), refusing more than
+    /// [`MAX_DEPTH`].
+    fn enter(&mut self) -> Result<(), SyntaxError> {
+        self.nest += 1;
+        if self.nest > MAX_DEPTH {
+            return Err(self.err(&format!(
+                "expression nested too deeply (more than {MAX_DEPTH} levels)"
+            )));
+        }
+        Ok(())
+    }
+
     /// `E1 := E1 ('+'|'-') E2 | E2`
     fn e1(&mut self) -> Result<Expr, SyntaxError> {
+        self.enter()?;
+        let e = self.e1_terms();
+        self.nest -= 1;
+        e
+    }
+
+    fn e1_terms(&mut self) -> Result<Expr, SyntaxError> {
         let mut e = self.e2()?;
         loop {
             self.skip_ws()?;
@@ -267,8 +325,10 @@ impl Parser {
         self.skip_ws()?;
         if self.peek() == Some('^') {
             self.bump();
-            let r = self.e3()?;
-            return Ok(Expr::Bin(BinOp::Pow, Box::new(e), Box::new(r)));
+            self.enter()?;
+            let r = self.e3();
+            self.nest -= 1;
+            return Ok(Expr::Bin(BinOp::Pow, Box::new(e), Box::new(r?)));
         }
         Ok(e)
     }

@@ -61,7 +61,21 @@ pub fn main_with(run: fn(Vec<String>) -> anyhow::Result<ExitCode>) -> ExitCode {
             return ExitCode::from(1);
         }
     };
-    match run(args) {
+    // the tool and rayon's global workers run on threads with deep stacks (deeply nested
+    // .cal expressions)
+    let _ = rayon::ThreadPoolBuilder::new()
+        .stack_size(crate::threads::STACK_BYTES)
+        .build_global();
+    let result = std::thread::Builder::new()
+        .name("main".into())
+        .stack_size(crate::threads::STACK_BYTES)
+        .spawn(move || run(args))
+        .map_err(anyhow::Error::from)
+        .and_then(|h| {
+            h.join()
+                .unwrap_or_else(|p| std::panic::resume_unwind(p))
+        });
+    match result {
         Ok(code) => code,
         Err(e) => {
             if let Some(Exit(code)) = e.downcast_ref::<Exit>() {

@@ -3,6 +3,19 @@
 
 use anyhow::{bail, Result};
 
+/// Stack size of the threads that run a tool and its workers: deep enough for the
+/// recursion of expressions nested to the .cal parser's limit (50 000 levels) and for
+/// dropping such trees. Only the pages used are committed.
+pub const STACK_BYTES: usize = 1 << 30;
+
+/// A worker pool of `n` threads with [`STACK_BYTES`] stacks.
+pub fn pool(n: usize) -> Result<rayon::ThreadPool> {
+    Ok(rayon::ThreadPoolBuilder::new()
+        .num_threads(n)
+        .stack_size(STACK_BYTES)
+        .build()?)
+}
+
 /// Threads for a request of `n` processes: an error below 1, capped at the cores
 /// available with a warning.
 pub fn worker_count(n: f64) -> Result<usize> {
