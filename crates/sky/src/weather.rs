@@ -182,8 +182,9 @@ fn read_wea(lines: &[String]) -> Result<Tape, WeatherError> {
         line,
         expected,
     };
+    // as Radiance's `%[^_]_%[^\r\n]`: a city (the country after '_' may be missing)
     let place = lines[0][6..].trim_end().to_string();
-    if !place.contains('_') {
+    if place.is_empty() || place.starts_with('_') {
         return Err(herr(1, "'place <city>_<country>'"));
     }
     let num = |i: usize, key: &str, exp: &'static str| -> Result<f64, WeatherError> {
@@ -196,7 +197,10 @@ fn read_wea(lines: &[String]) -> Result<Tape, WeatherError> {
     let lon_west = num(2, "longitude", "'longitude <degrees west>'")?;
     let tz = num(3, "time_zone", "'time_zone <meridian degrees west>'")? as f32;
     let elevation = num(4, "site_elevation", "'site_elevation <m>'")? as f32;
-    let timezone = tz * (-1.0f32 / 15.0);
+    // Radiance scales the single-precision value in double precision and stores it back
+    // in single: time_zone -180 is exactly 12 hours (in f32 arithmetic it would be
+    // 12.000001 and refused)
+    let timezone = (f64::from(tz) * (-1.0 / 15.0)) as f32;
     let longitude = -lon_west;
     check_location(latitude, longitude, timezone, elevation, "WEA", 5)?;
     let units = match num(
