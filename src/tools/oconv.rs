@@ -41,6 +41,17 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         bail!("no scene files given (usage: oconv file.rad … > scene.oct)");
     }
     let scene = parser.finish();
+    // the tracer's own geometry rules: what rtrace would refuse is refused here, what it
+    // would ignore is reported here
+    for p in &scene.prims {
+        if p.modifier.is_some() && fenestra_trace::surface::is_geometry(&p.ptype) {
+            match fenestra_trace::surface::shape_of(p)? {
+                fenestra_trace::surface::Built::Shape(_, Some(w))
+                | fenestra_trace::surface::Built::Ignored(w) => fenestra_cli::warn(w),
+                fenestra_trace::surface::Built::Shape(_, None) => {}
+            }
+        }
+    }
     let mut buf = Vec::new();
     compiled::write(
         &mut buf,

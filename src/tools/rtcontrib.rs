@@ -12,6 +12,9 @@ use fenestra_contrib::engine::{
 use fenestra_contrib::output::{self, Format, HeaderInfo, ModOut, Spec, Stream};
 use fenestra_trace::{TraceOptions, Tracer};
 
+/// Most bins one modifier may have (2^24: 400 MiB of sums per thread).
+const MAX_BINS: usize = 1 << 24;
+
 const USAGE: &str = "[-n N][-V][-I|-i][-c N][-f{a,f,d}{a,f,d,c}][-fo|-r][-x X -y Y][-o spec][-E][-Eo spec][-Eb N][-p a=1,..][-e expr][-f file.cal][-b binexpr][-bn N] {-m mod | -M file} .. [-ab N -ad N -lw W -lr N -ds V -dj V -st V -ss V -bv -seed N ..] scene.{oct,rad} ..";
 
 struct ModArg {
@@ -253,6 +256,11 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                     let v = defs
                         .eval_now(w)
                         .with_context(|| format!("-bn {w} (definitions must come before -bn)"))?;
+                    // memory is taken per bin (sums, errors, output items): a count no
+                    // run could hold is refused at once, as Radiance's allocation fails
+                    if v + 0.5 > MAX_BINS as f64 {
+                        bail!("-bn {w}: {v} bins are more than the {MAX_BINS} a modifier may have");
+                    }
                     cur_nbins = if v + 0.5 >= 1.0 {
                         Some((v + 0.5) as usize)
                     } else {

@@ -8,6 +8,12 @@
 use anyhow::{bail, Context, Result};
 
 const MAX_DEPTH: usize = 32;
+/// Largest option file read (1 MiB): `@/dev/zero` or a huge file is an error, not a
+/// process that grows without limit.
+const MAX_FILE_BYTES: u64 = 1 << 20;
+/// Most words the expansion may produce (files that include each other twice over
+/// would double at each level).
+const MAX_WORDS: usize = 1 << 20;
 
 /// Expands every `@file` and `$VAR` argument after the program name.
 pub fn expand_args(args: Vec<String>) -> Result<Vec<String>> {
@@ -27,8 +33,20 @@ fn expand_one(arg: String, depth: usize, out: &mut Vec<String>) -> Result<()> {
         if depth >= MAX_DEPTH {
             bail!("option files nested more than {MAX_DEPTH} deep at '{arg}' (a file that includes itself?)");
         }
-        let text = std::fs::read_to_string(file)
-            .with_context(|| format!("cannot read option file '{file}'"))?;
+        let mut bytes = Vec::new();
+        std::io::Read::read_to_end(
+            &mut std::io::Read::take(
+                std::fs::File::open(file)
+                    .with_context(|| format!("cannot read option file '{file}'"))?,
+                MAX_FILE_BYTES + 1,
+            ),
+            &mut bytes,
+        )
+        .with_context(|| format!("cannot read option file '{file}'"))?;
+        if bytes.len() as u64 > MAX_FILE_BYTES {
+            bail!("option file '{file}' is larger than {MAX_FILE_BYTES} bytes");
+        }
+        let text = String::from_utf8_lossy(&bytes);
         let words = split_words(&text).with_context(|| format!("in option file '{file}'"))?;
         for w in words {
             expand_one(w, depth + 1, out)?;
@@ -47,6 +65,9 @@ fn expand_one(arg: String, depth: usize, out: &mut Vec<String>) -> Result<()> {
             expand_one(w, depth + 1, out)?;
         }
         return Ok(());
+    }
+    if out.len() >= MAX_WORDS {
+        bail!("option files and variables expand to more than {MAX_WORDS} words");
     }
     out.push(arg);
     Ok(())

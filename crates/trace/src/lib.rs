@@ -21,6 +21,7 @@ pub mod pattern;
 pub mod polygon;
 pub mod rng;
 pub mod shape;
+pub mod surface;
 pub mod tracer;
 
 pub use glam::DVec3;

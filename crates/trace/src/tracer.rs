@@ -16,7 +16,6 @@ use crate::clip::ClipSet;
 use crate::material::{compile, is_pattern, LightKind, Material, FTINY};
 use crate::options::TraceOptions;
 use crate::pattern::PatternInput;
-use crate::polygon::Polygon;
 use crate::rng::Rng;
 use crate::shape::Shape;
 
@@ -272,77 +271,16 @@ impl Tracer {
             let r = &p.rargs;
             let bad = |what: &str| anyhow::anyhow!("{}: {} '{}': {what}", p.loc, p.ptype, p.name);
             let shape = match p.ptype.as_str() {
-                "polygon" => {
-                    if r.len() % 3 != 0 {
-                        return Err(bad("polygon needs a multiple of 3 real arguments"));
-                    }
-                    let verts: Vec<DVec3> =
-                        r.chunks(3).map(|c| DVec3::new(c[0], c[1], c[2])).collect();
-                    match Polygon::new(verts) {
-                        Ok((poly, warn)) => {
-                            if let Some(w) = warn {
-                                warnings.push(format!("{}: polygon '{}': {w}", p.loc, p.name));
-                            }
-                            Shape::Polygon(poly)
+                t if crate::surface::is_geometry(t) => {
+                    match crate::surface::shape_of(p)? {
+                        crate::surface::Built::Shape(shape, warn) => {
+                            warnings.extend(warn);
+                            shape
                         }
-                        Err(e) => {
-                            warnings.push(format!("{}: polygon '{}': {e}; ignored", p.loc, p.name));
+                        crate::surface::Built::Ignored(warn) => {
+                            warnings.push(warn);
                             continue;
                         }
-                    }
-                }
-                "sphere" | "bubble" => {
-                    if r.len() != 4 || r[3] <= 0.0 {
-                        return Err(bad("needs 4 real arguments (centre, radius > 0)"));
-                    }
-                    Shape::Sphere {
-                        c: DVec3::new(r[0], r[1], r[2]),
-                        r: r[3],
-                        inward: p.ptype == "bubble",
-                    }
-                }
-                "cone" | "cup" | "cylinder" | "tube" => {
-                    let cyl = p.ptype == "cylinder" || p.ptype == "tube";
-                    if r.len() != if cyl { 7 } else { 8 } {
-                        return Err(bad("wrong number of real arguments"));
-                    }
-                    let p0 = DVec3::new(r[0], r[1], r[2]);
-                    let p1 = DVec3::new(r[3], r[4], r[5]);
-                    let (r0, r1) = if cyl { (r[6], r[6]) } else { (r[6], r[7]) };
-                    let len = (p1 - p0).length();
-                    if len <= 0.0 || r0 < 0.0 || r1 < 0.0 || (r0 == 0.0 && r1 == 0.0) {
-                        warnings.push(format!(
-                            "{}: {} '{}' is degenerate; ignored",
-                            p.loc, p.ptype, p.name
-                        ));
-                        continue;
-                    }
-                    Shape::Cone {
-                        p0,
-                        axis: (p1 - p0) / len,
-                        len,
-                        r0,
-                        r1,
-                        inward: p.ptype == "cup" || p.ptype == "tube",
-                    }
-                }
-                "ring" => {
-                    if r.len() != 8 {
-                        return Err(bad("needs 8 real arguments"));
-                    }
-                    let n = DVec3::new(r[3], r[4], r[5]);
-                    if n.length() == 0.0 || r[6] < 0.0 || r[7] <= r[6] {
-                        warnings.push(format!(
-                            "{}: ring '{}' is degenerate; ignored",
-                            p.loc, p.name
-                        ));
-                        continue;
-                    }
-                    Shape::Ring {
-                        c: DVec3::new(r[0], r[1], r[2]),
-                        n: n.normalize(),
-                        r0: r[6],
-                        r1: r[7],
                     }
                 }
                 "source" => {
