@@ -103,8 +103,9 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         let mut xargs = vec!["xform".to_string(), "-m".to_string(), "void".to_string()];
         xargs.extend(files.iter().cloned());
         let (xo, xfiles) = fenestra_scene::xform::XformOptions::parse(&xargs)?;
-        let mut text = String::new();
-        fenestra_scene::xform::xform_files(&xo, &xfiles, &mut text)?;
+        let mut bytes = Vec::new();
+        fenestra_scene::xform::xform_files(&xo, &xfiles, &mut bytes)?;
+        let text = fenestra_scene::decode_text(bytes);
         let scene = fenestra_scene::parse_str(&text, &files.join(" "))?;
         let (ap, warnings) = aperture_from_scene(&scene, vd)?;
         for w in warnings {

@@ -32,10 +32,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         return Ok(ExitCode::SUCCESS);
     }
     let (opts, files) = XformOptions::parse(&args)?;
-    let mut out = String::new();
-    xform_files(&opts, &files, &mut out)?;
-    let mut so = std::io::stdout().lock();
-    so.write_all(out.as_bytes())?;
+    let mut so = std::io::BufWriter::with_capacity(1 << 16, std::io::stdout().lock());
+    xform_files(&opts, &files, &mut so)?;
     so.flush()?;
     Ok(ExitCode::SUCCESS)
 }

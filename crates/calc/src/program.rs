@@ -157,12 +157,16 @@ impl Program {
 
     /// Loads definitions from a file.
     pub fn load_file(&mut self, path: &Path) -> Result<(), CalcError> {
-        let text = std::fs::read_to_string(path).map_err(|e| {
+        let bytes = std::fs::read(path).map_err(|e| {
             CalcError::new(
                 ErrorKind::Io,
                 format!("cannot read file '{}': {e}", path.display()),
             )
         })?;
+        // bytes as Radiance reads them: text that is not UTF-8 is taken one byte per
+        // character (names and numbers are ASCII; comments may be Latin-1)
+        let text = String::from_utf8(bytes)
+            .unwrap_or_else(|e| e.into_bytes().iter().map(|&b| char::from(b)).collect());
         self.load_str(&path.display().to_string(), &text)
     }
 

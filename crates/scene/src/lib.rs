@@ -13,5 +13,5 @@ mod words;
 pub mod xform;
 
 pub use model::{Loc, Primitive, Scene};
-pub use rad::{load, parse_str, Parser};
+pub use rad::{decode_text, decode_text_latin1, encode_text, load, parse_str, Parser};
 pub use words::parse_real;

@@ -376,13 +376,13 @@ impl State {
         } else {
             l.dir.join(name)
         };
-        let text = std::fs::read_to_string(&path).with_context(|| {
+        let text = crate::rad::decode_text(std::fs::read(&path).with_context(|| {
             format!(
                 "{}: cannot read included MGF file '{}'",
                 l.loc,
                 path.display()
             )
-        })?;
+        })?);
         let file: Arc<str> = Arc::from(path.display().to_string());
         let dir = Arc::new(path.parent().map(Path::to_path_buf).unwrap_or_default());
         let lines = split_lines(&text, file, dir)?;

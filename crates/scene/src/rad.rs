@@ -39,10 +39,10 @@ impl Parser {
     /// else Radiance scene text.
     pub fn add_path(&mut self, path: &str) -> Result<()> {
         if path == "-" {
-            let mut text = String::new();
-            std::io::Read::read_to_string(&mut std::io::stdin(), &mut text)
+            let mut bytes = Vec::new();
+            std::io::Read::read_to_end(&mut std::io::stdin(), &mut bytes)
                 .context("cannot read the scene from standard input")?;
-            return self.add_str(&text, "-");
+            return self.add_str(&decode_text(bytes), "-");
         }
         let bytes =
             std::fs::read(path).with_context(|| format!("cannot open scene file '{path}'"))?;
@@ -50,8 +50,7 @@ impl Parser {
             let c = crate::compiled::read(&bytes).with_context(|| path.to_string())?;
             return self.add_scene(c.scene);
         }
-        let text = String::from_utf8(bytes)
-            .map_err(|_| anyhow!("{path}: not a text file (invalid UTF-8)"))?;
+        let text = decode_text(bytes);
         if path.to_ascii_lowercase().ends_with(".mgf") {
             return self.add_mgf(&text, path);
         }
@@ -277,11 +276,13 @@ pub(crate) fn command_output(cmd: &str) -> Result<String> {
     if !out.status.success() {
         bail!("command failed ({})", out.status);
     }
-    String::from_utf8(out.stdout).map_err(|_| anyhow!("command output is not UTF-8 text"))
+    Ok(decode_text(out.stdout))
 }
 
 /// Reads a text file, with an error naming it; a Radiance octree gets a specific message.
-pub(crate) fn read_text(path: &str) -> Result<String> {
+/// The bytes of a scene text file, with an error naming it (an octree or compiled scene
+/// gets a specific message).
+pub(crate) fn read_text_bytes(path: &str) -> Result<Vec<u8>> {
     let bytes = std::fs::read(path).with_context(|| format!("cannot open scene file '{path}'"))?;
     if crate::compiled::is_radiance_octree(&bytes) {
         bail!("{path}: this is an octree written by Radiance's oconv, which fenestra cannot read; pass the .rad files instead");
@@ -289,7 +290,32 @@ pub(crate) fn read_text(path: &str) -> Result<String> {
     if crate::compiled::is_compiled(&bytes) {
         bail!("{path}: this is a compiled scene (fenestra oconv output), not scene text");
     }
-    String::from_utf8(bytes).map_err(|_| anyhow!("{path}: not a text file (invalid UTF-8)"))
+    Ok(bytes)
+}
+
+/// Scene text from bytes: UTF-8 when valid, otherwise one character per byte (Latin-1),
+/// as Radiance reads bytes; names and numbers are ASCII either way.
+pub fn decode_text(bytes: Vec<u8>) -> String {
+    String::from_utf8(bytes)
+        .unwrap_or_else(|e| e.into_bytes().iter().map(|&b| char::from(b)).collect())
+}
+
+/// Text read as [`decode_text`] does, and whether it was read one byte per character
+/// (not valid UTF-8), so output made from it can be written back byte for byte.
+pub fn decode_text_latin1(bytes: Vec<u8>) -> (String, bool) {
+    match String::from_utf8(bytes) {
+        Ok(s) => (s, false),
+        Err(e) => (e.into_bytes().iter().map(|&b| char::from(b)).collect(), true),
+    }
+}
+
+/// Bytes of text: one byte per character when `latin1` (text that
+/// [`decode_text_latin1`] read byte for byte, plus ASCII), UTF-8 otherwise.
+pub fn encode_text(text: &str, latin1: bool) -> Vec<u8> {
+    if latin1 && text.chars().all(|c| u32::from(c) <= 0xFF) {
+        return text.chars().map(|c| u32::from(c) as u8).collect();
+    }
+    text.as_bytes().to_vec()
 }
 
 /// Parses Radiance scene text into a scene; `file` names it in messages.

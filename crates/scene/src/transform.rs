@@ -234,10 +234,34 @@ pub(crate) fn invert3(m: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
     r
 }
 
+/// `total` followed by `group` applied `reps` times, one product at a time (Radiance's
+/// order of operations, so the digits are Radiance's). xform's arrays (`-a N` becomes
+/// `-i 0`, `-i 1`, … `-i N-1`) repeat the same group ever more often: the last products
+/// are remembered and continued, which keeps the digits and makes an array linear in N.
 fn repeat(total: &Transform, group: &Transform, reps: i64) -> Transform {
-    let mut t = *total;
-    for _ in 0..reps {
+    thread_local! {
+        static LAST: std::cell::RefCell<Vec<(Transform, Transform, i64, Transform)>> =
+            const { std::cell::RefCell::new(Vec::new()) };
+    }
+    let (mut t, done) = LAST.with(|c| {
+        c.borrow()
+            .iter()
+            .filter(|(a, g, n, _)| a == total && g == group && *n <= reps)
+            .max_by_key(|e| e.2)
+            .map_or((*total, 0), |e| (e.3, e.2))
+    });
+    for _ in done..reps {
         t = t.then(group);
+    }
+    if reps > 1 {
+        LAST.with(|c| {
+            let mut c = c.borrow_mut();
+            c.retain(|(a, g, _, _)| !(a == total && g == group));
+            if c.len() >= 8 {
+                c.remove(0);
+            }
+            c.push((*total, *group, reps, t));
+        });
     }
     t
 }

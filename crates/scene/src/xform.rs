@@ -136,7 +136,7 @@ impl XformOptions {
     }
 
     /// The runs an array (`-a N`) expands to; one run without arrays.
-    pub fn array_runs(&self) -> Result<Vec<XformOptions>> {
+    pub fn array_runs(&self) -> Result<ArrayRuns<'_>> {
         let arrays: Vec<(usize, usize)> = self
             .xf_words
             .iter()
@@ -149,40 +149,80 @@ impl XformOptions {
                     .ok_or_else(|| anyhow!("-a: expected a count, got '{w}'"))
             })
             .collect::<Result<_>>()?;
-        if arrays.is_empty() {
-            return Ok(vec![self.clone()]);
-        }
-        let mut runs = Vec::new();
-        let total: usize = arrays.iter().map(|a| a.1).product();
-        for flat in 0..total {
-            let mut idx = vec![0usize; arrays.len()];
-            let mut rest = flat;
-            for d in (0..arrays.len()).rev() {
-                idx[d] = rest % arrays[d].1;
-                rest /= arrays[d].1;
-            }
-            let mut run = self.clone();
-            let mut name = match &self.name {
-                Some(n) => format!("{n}.{}", idx[0]),
-                None => format!("a{}", idx[0]),
-            };
-            for k in &idx[1..] {
-                let _ = write!(name, ".{k}");
-            }
-            run.name = Some(name);
-            for (d, (pos, _)) in arrays.iter().enumerate() {
-                run.xf_words[*pos] = "-i".into();
-                run.xf_words[*pos + 1] = idx[d].to_string();
-            }
-            runs.push(run);
-        }
-        Ok(runs)
+        let total = if arrays.is_empty() {
+            1
+        } else {
+            arrays
+                .iter()
+                .try_fold(1usize, |t, a| t.checked_mul(a.1))
+                .ok_or_else(|| anyhow!("-a: the arrays hold more copies than can be counted"))?
+        };
+        Ok(ArrayRuns {
+            opts: self,
+            arrays,
+            next: 0,
+            total,
+        })
     }
 }
 
-/// Runs xform over `files` (standard input when empty), writing the whole output.
-pub fn xform_files(opts: &XformOptions, files: &[String], out: &mut String) -> Result<()> {
+/// The runs of an xform command with arrays, made one at a time (`-a 100000000 | head`
+/// starts at once and holds one run).
+pub struct ArrayRuns<'a> {
+    opts: &'a XformOptions,
+    arrays: Vec<(usize, usize)>,
+    next: usize,
+    total: usize,
+}
+
+impl Iterator for ArrayRuns<'_> {
+    type Item = XformOptions;
+
+    fn next(&mut self) -> Option<XformOptions> {
+        if self.next >= self.total {
+            return None;
+        }
+        let flat = self.next;
+        self.next += 1;
+        if self.arrays.is_empty() {
+            return Some(self.opts.clone());
+        }
+        let mut idx = vec![0usize; self.arrays.len()];
+        let mut rest = flat;
+        for d in (0..self.arrays.len()).rev() {
+            idx[d] = rest % self.arrays[d].1;
+            rest /= self.arrays[d].1;
+        }
+        let mut run = self.opts.clone();
+        let mut name = match &self.opts.name {
+            Some(n) => format!("{n}.{}", idx[0]),
+            None => format!("a{}", idx[0]),
+        };
+        for k in &idx[1..] {
+            let _ = write!(name, ".{k}");
+        }
+        run.name = Some(name);
+        for (d, (pos, _)) in self.arrays.iter().enumerate() {
+            run.xf_words[*pos] = "-i".into();
+            run.xf_words[*pos + 1] = idx[d].to_string();
+        }
+        Some(run)
+    }
+}
+
+/// Runs xform over `files` (standard input, read once, when empty), writing to `sink` as
+/// each run (array element) is done.
+pub fn xform_files(
+    opts: &XformOptions,
+    files: &[String],
+    sink: &mut dyn std::io::Write,
+) -> Result<()> {
+    let mut stdin_text: Option<(String, bool)> = None;
+    let mut texts: Vec<Option<(String, bool)>> = vec![None; files.len()];
+    let mut out = String::new();
     for run in opts.array_runs()? {
+        let out = &mut out;
+        out.clear();
         let xf = Transform::parse_all(&run.xf_words)?;
         let _ = write!(out, "# {}", run.argv0);
         for w in run.header_words() {
@@ -194,15 +234,33 @@ pub fn xform_files(opts: &XformOptions, files: &[String], out: &mut String) -> R
             xf,
             depth: 0,
         };
+        // each input's part of the output is written in its own encoding (a Latin-1
+        // file's comments go out byte for byte)
+        let mut put = |out: &mut String, latin1: bool| -> Result<()> {
+            sink.write_all(&crate::rad::encode_text(out, latin1))
+                .context("cannot write the output")?;
+            out.clear();
+            Ok(())
+        };
+        put(out, false)?;
         if files.is_empty() {
-            let mut text = String::new();
-            std::io::Read::read_to_string(&mut std::io::stdin(), &mut text)
-                .context("cannot read standard input")?;
-            x.text(&text, "-", out)?;
+            if stdin_text.is_none() {
+                let mut bytes = Vec::new();
+                std::io::Read::read_to_end(&mut std::io::stdin(), &mut bytes)
+                    .context("cannot read standard input")?;
+                stdin_text = Some(crate::rad::decode_text_latin1(bytes));
+            }
+            let (text, latin1) = stdin_text.as_ref().map_or(("", false), |(t, l)| (t.as_str(), *l));
+            x.text(text, "-", out)?;
+            put(out, latin1)?;
         } else {
-            for f in files {
-                let text = crate::rad::read_text(f)?;
-                x.text(&text, f, out)?;
+            for (f, t) in files.iter().zip(texts.iter_mut()) {
+                if t.is_none() {
+                    *t = Some(crate::rad::decode_text_latin1(crate::rad::read_text_bytes(f)?));
+                }
+                let (text, latin1) = t.as_ref().map_or(("", false), |(t, l)| (t.as_str(), *l));
+                x.text(text, f, out)?;
+                put(out, latin1)?;
             }
         }
     }
@@ -223,9 +281,9 @@ pub fn run_inline(cmd: &str) -> Result<Option<String>> {
     if files.is_empty() {
         return Ok(None);
     }
-    let mut out = String::new();
+    let mut out = Vec::new();
     xform_files(&opts, &files, &mut out)?;
-    Ok(Some(out))
+    Ok(Some(crate::rad::decode_text(out)))
 }
 
 struct Xformer<'a> {
