@@ -123,7 +123,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 let d = real(&args, i).unwrap_or(0.0);
                 let mut sa = PI / 360.0 * d;
                 if sa <= 0.0 {
-                    bail!("missing solar disk size argument for '-5' option");
+                    bail!("missing solar disk size argument for '-5' option (a positive size in degrees)");
                 }
                 sa = sa * (sa * PI);
                 o.settings.nsuns = 1;

@@ -32,6 +32,9 @@ pub fn open(name: &str) -> Result<Box<dyn BufRead + Send>> {
             },
         )));
     }
+    if std::path::Path::new(name).is_dir() {
+        anyhow::bail!("cannot open input file '{name}': it is a directory");
+    }
     let f =
         std::fs::File::open(name).with_context(|| format!("cannot open input file '{name}'"))?;
     Ok(Box::new(BufReader::with_capacity(1 << 16, f)))

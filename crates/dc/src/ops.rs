@@ -53,7 +53,10 @@ fn unscale_factors(h: &fenestra_formats::header::Header, ncomp: usize) -> Result
     for v in h.get_all("EXPOSURE") {
         match v.trim().parse::<f64>() {
             Ok(x) if x > 0.0 && x.is_finite() => e *= x as f32,
-            _ => bail!("bad header line EXPOSURE={v} (expected a positive number)"),
+            _ => bail!(
+                "bad header line EXPOSURE={} (expected a positive number)",
+                fenestra_formats::header::printable(v)
+            ),
         }
     }
     let mut cc = [1.0f32; 3];
@@ -64,7 +67,10 @@ fn unscale_factors(h: &fenestra_formats::header::Header, ncomp: usize) -> Result
             .filter(|x| *x > 0.0 && x.is_finite())
             .collect();
         if w.len() != 3 {
-            bail!("bad header line COLORCORR={v} (expected three positive numbers)");
+            bail!(
+                "bad header line COLORCORR={} (expected three positive numbers)",
+                fenestra_formats::header::printable(v)
+            );
         }
         for (c, x) in cc.iter_mut().zip(&w) {
             *c *= *x as f32;

@@ -126,7 +126,10 @@ impl Header {
             None => Ok(None),
             Some(v) => match v.trim().parse::<usize>() {
                 Ok(n) if n > 0 => Ok(Some(n)),
-                _ => bail!("bad header line {key}={v} (expected a positive integer)"),
+                _ => bail!(
+                    "bad header line {key}={} (expected a positive integer)",
+                    printable(v)
+                ),
             },
         }
     }
@@ -148,7 +151,10 @@ impl Header {
         for v in self.get_all("EXPOSURE") {
             match v.trim().parse::<f64>() {
                 Ok(x) if x > 0.0 && x.is_finite() => e *= x,
-                _ => bail!("bad header line EXPOSURE={v} (expected a positive number)"),
+                _ => bail!(
+                    "bad header line EXPOSURE={} (expected a positive number)",
+                    printable(v)
+                ),
             }
         }
         Ok(e)
@@ -165,7 +171,10 @@ impl Header {
                 .ok()
                 .filter(|x: &Vec<f64>| x.len() == 3 && x.iter().all(|y| *y > 0.0 && y.is_finite()))
                 .with_context(|| {
-                    format!("bad header line COLORCORR={v} (expected three positive numbers)")
+                    format!(
+                        "bad header line COLORCORR={} (expected three positive numbers)",
+                        printable(v)
+                    )
                 })?;
             for k in 0..3 {
                 c[k] *= vals[k];
@@ -332,4 +341,25 @@ mod tests {
         assert!(!is_assignment("rcalc -e x=1"));
         assert!(!is_assignment("=3"));
     }
+}
+
+/// Text of a header value fit for a message: printable ASCII as it is, anything else
+/// (control bytes, binary garbage, characters outside ASCII) as `\xNN` / `\u{…}` escapes, at
+/// most 80 characters.
+pub fn printable(v: &str) -> String {
+    let mut out = String::new();
+    for (i, c) in v.chars().enumerate() {
+        if i == 80 {
+            out.push('…');
+            break;
+        }
+        if c.is_ascii_graphic() || c == ' ' {
+            out.push(c);
+        } else if (c as u32) < 0x80 {
+            out.push_str(&format!("\\x{:02x}", c as u32));
+        } else {
+            out.push_str(&c.escape_unicode().to_string());
+        }
+    }
+    out
 }

@@ -143,7 +143,7 @@ impl MatrixReader {
                 None if f == "Radiance_spectra" => {
                     bail!("{name}: FORMAT=Radiance_spectra (spectral matrices) is not supported by fenestra")
                 }
-                None => bail!("{name}: unknown data format FORMAT={f} in header (expected ascii, float, double, 32-bit_rle_rgbe or 32-bit_rle_xyze)"),
+                None => bail!("{name}: unknown data format FORMAT={} in header (expected ascii, float, double, 32-bit_rle_rgbe or 32-bit_rle_xyze)", crate::header::printable(f)),
             },
         };
         let nrows = header.nrows().map_err(ctx)?;
@@ -399,7 +399,7 @@ impl MatrixReader {
         self.pixels.resize(nc, [0; 4]);
         let row = self.rows_read + 1;
         rgbe::read_scanline(&mut self.r, &mut self.pixels, &self.name)
-            .with_context(|| format!("{}: in row {row}", self.name))?;
+            .map_err(|e| anyhow::anyhow!("{e:#} (row {row})"))?;
         for (o, p) in out.chunks_exact_mut(3).zip(&self.pixels) {
             o.copy_from_slice(&rgbe::decode(*p));
         }
