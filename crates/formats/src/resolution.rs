@@ -7,6 +7,9 @@
 
 use std::fmt;
 
+/// Longest side of a picture accepted: 2^24 pixels (a scanline buffer of 64 MiB).
+pub const MAX_SIDE: usize = 1 << 24;
+
 /// X decreases along a scanline (or from scanline to scanline when not Y-major).
 pub const XDECR: u8 = 1;
 /// Y decreases.
@@ -81,6 +84,8 @@ impl Resolution {
     }
 
     /// Parses a resolution line (`-Y 26 +X 32`, any of the eight forms; padding free).
+    /// Sides over [`MAX_SIDE`] pixels are refused (`None`), so a damaged line cannot
+    /// ask for a scanline buffer of gigabytes.
     pub fn parse(line: &str) -> Option<Self> {
         let w: Vec<&str> = line.split_whitespace().collect();
         if w.len() != 4 {
@@ -104,8 +109,8 @@ impl Resolution {
         if a1 == a2 {
             return None;
         }
-        let n1: usize = w[1].parse().ok()?;
-        let n2: usize = w[3].parse().ok()?;
+        let n1: usize = w[1].parse().ok().filter(|&n| n <= MAX_SIDE)?;
+        let n2: usize = w[3].parse().ok().filter(|&n| n <= MAX_SIDE)?;
         let mut orient = 0;
         let (xr, yr, xdec, ydec) = if a1 == 'Y' {
             orient |= YMAJOR;

@@ -150,16 +150,29 @@ fn parse_f32(w: &str) -> Option<f32> {
     w.parse::<f32>().ok().filter(|v| v.is_finite())
 }
 
+/// Whether `s` starts with the ASCII `prefix`, ignoring case (byte-wise: no slicing
+/// inside a character).
+fn starts_ci(s: &str, prefix: &str) -> bool {
+    s.as_bytes()
+        .get(..prefix.len())
+        .is_some_and(|b| b.eq_ignore_ascii_case(prefix.as_bytes()))
+}
+
 /// Reads a .wea or .epw tape (decided by the first line).
 pub fn read_tape(input: &mut dyn BufRead) -> Result<Tape, WeatherError> {
+    // bytes as Radiance reads them: a line that is not UTF-8 is read lossily (names only)
     let mut lines: Vec<String> = Vec::new();
-    for l in input.lines() {
-        lines.push(l?);
+    for l in input.split(b'\n') {
+        let mut l = l?;
+        if l.last() == Some(&b'\r') {
+            l.pop();
+        }
+        lines.push(String::from_utf8_lossy(&l).into_owned());
     }
     let first = lines.first().map(String::as_str).unwrap_or("");
-    if first.len() >= 6 && first[..6].eq_ignore_ascii_case("place ") {
+    if starts_ci(first, "place ") {
         read_wea(&lines)
-    } else if first.len() >= 9 && first[..9].eq_ignore_ascii_case("LOCATION,") {
+    } else if starts_ci(first, "LOCATION,") {
         read_epw(&lines)
     } else {
         Err(WeatherError::Header {
@@ -350,7 +363,7 @@ fn read_epw(lines: &[String]) -> Result<Tape, WeatherError> {
     ];
     for (k, h) in heads.iter().enumerate() {
         let l = lines.get(k + 1).map(String::as_str).unwrap_or("");
-        if l.len() < h.len() || !l[..h.len()].eq_ignore_ascii_case(h) {
+        if !starts_ci(l, h) {
             return Err(herr(k + 2, "the EPW header lines in order"));
         }
     }

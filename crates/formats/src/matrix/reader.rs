@@ -94,6 +94,7 @@ pub struct MatrixReader {
     pixels: Vec<[u8; 4]>,
     tok: Vec<u8>,
     size_checked: bool,
+    warned_nonfinite: bool,
 }
 
 impl MatrixReader {
@@ -216,6 +217,7 @@ impl MatrixReader {
             pixels: Vec::new(),
             tok: Vec::new(),
             size_checked: false,
+            warned_nonfinite: false,
         })
     }
 
@@ -331,6 +333,14 @@ impl MatrixReader {
             }
         }
         self.rows_read += 1;
+        if !self.warned_nonfinite && out.iter().any(|v| !v.is_finite()) {
+            // carried through as Radiance does, but never silently
+            self.warned_nonfinite = true;
+            fenestra_cli::warn(format!(
+                "{}: row {} holds a value that is not a finite number (nan or inf); results that use it will be too",
+                self.name, self.rows_read
+            ));
+        }
         Ok(true)
     }
 
