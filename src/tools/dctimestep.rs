@@ -649,7 +649,11 @@ fn matrix_form(
         return Ok(());
     }
 
-    let out_name = o.out_spec.as_deref().map(|s| fenestra_cli::printf::format_int_field(s, 0)).transpose()?;
+    let out_name = o
+        .out_spec
+        .as_deref()
+        .map(|s| fenestra_cli::printf::format_int_field(s, 0))
+        .transpose()?;
     let mut vr = VRows::new(vr)?;
     let nrows = vr.nrows();
     let (orows, ocols) = reshape(nrows, steps, o)?;
@@ -786,7 +790,9 @@ fn picture_form(vspec: &str, td: Option<Planar>, sky: &PackedSky, o: &Opts) -> R
         // A picture file named *.exr is written as OpenEXR (one file per time step).
         let exr_name = match (&per_step, o.out_spec.as_deref()) {
             (Some(p), _) => Some(fenestra_cli::printf::format_int_field(p, t)?),
-            (None, Some(spec)) if steps == 1 => Some(fenestra_cli::printf::format_int_field(spec, 0)?),
+            (None, Some(spec)) if steps == 1 => {
+                Some(fenestra_cli::printf::format_int_field(spec, 0)?)
+            }
             _ => None,
         }
         .filter(|n| fenestra_formats::exr::is_exr_path(n));
@@ -817,7 +823,11 @@ fn picture_form(vspec: &str, td: Option<Planar>, sky: &PackedSky, o: &Opts) -> R
             }
             None => {
                 if stdout_dest.is_none() {
-                    let name = o.out_spec.as_deref().map(|s| fenestra_cli::printf::format_int_field(s, 0)).transpose()?;
+                    let name = o
+                        .out_spec
+                        .as_deref()
+                        .map(|s| fenestra_cli::printf::format_int_field(s, 0))
+                        .transpose()?;
                     stdout_dest = Some(Dest::open(name.as_deref())?);
                 }
                 let (d, _) = stdout_dest.as_mut().expect("destination");

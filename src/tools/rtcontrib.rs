@@ -6,9 +6,7 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 use fenestra_contrib::calc::{is_zero_constant, parse_params, BinRequest, Bins, CalcDefs};
-use fenestra_contrib::engine::{
-    Engine, InFormat, InputRay, RayInput, Record, RunOptions, Tracked,
-};
+use fenestra_contrib::engine::{Engine, InFormat, InputRay, RayInput, Record, RunOptions, Tracked};
 use fenestra_contrib::output::{self, Format, HeaderInfo, ModOut, Spec, Stream};
 use fenestra_trace::{TraceOptions, Tracer};
 

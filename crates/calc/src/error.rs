@@ -76,13 +76,23 @@ impl fmt::Display for CalcError {
                     l.source, l.line, l.column, self.message
                 )?;
                 if !l.text.is_empty() {
-                    let caret: String = l
-                        .text
-                        .chars()
-                        .take(l.column.saturating_sub(1))
-                        .map(|c| if c == '\t' { '\t' } else { ' ' })
+                    // at most WINDOW characters of the line, around the column
+                    const WINDOW: usize = 100;
+                    let chars: Vec<char> = l.text.chars().collect();
+                    let col = l.column.saturating_sub(1).min(chars.len());
+                    let start = col.saturating_sub(WINDOW / 2);
+                    let end = (start + WINDOW).min(chars.len());
+                    let shown: String = chars[start..end].iter().collect();
+                    let caret: String = chars[start..col]
+                        .iter()
+                        .map(|&c| if c == '\t' { '\t' } else { ' ' })
                         .collect();
-                    write!(f, "\n  {}\n  {}^", l.text, caret)?;
+                    let (pre, post) = (
+                        if start > 0 { "…" } else { "" },
+                        if end < chars.len() { "…" } else { "" },
+                    );
+                    let pad = if start > 0 { " " } else { "" };
+                    write!(f, "\n  {pre}{shown}{post}\n  {pad}{caret}^")?;
                 }
                 Ok(())
             }

@@ -12,7 +12,7 @@ pub mod printf;
 pub mod progress;
 pub mod raypath;
 pub mod rays;
-pub mod threads;
 mod run;
+pub mod threads;
 
 pub use run::{command_line, main_with, prog, set_prog, set_warnings, warn, Exit};

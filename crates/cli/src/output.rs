@@ -26,7 +26,10 @@ pub fn target_kind(path: &Path) -> Result<Target> {
     match std::fs::symlink_metadata(path) {
         Err(_) => Ok(Target::Replace),
         Ok(m) if m.file_type().is_file() => Ok(Target::Replace),
-        Ok(m) if m.is_dir() => bail!("cannot write output '{}': it is a directory", path.display()),
+        Ok(m) if m.is_dir() => bail!(
+            "cannot write output '{}': it is a directory",
+            path.display()
+        ),
         Ok(_) => Ok(Target::Through),
     }
 }

@@ -139,7 +139,11 @@ impl<R: BufRead> RayReader<R> {
                 f64::from_ne_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]])
             };
         }
-        Ok(if got == want { 6 } else { whole.max(usize::from(got > 0)) })
+        Ok(if got == want {
+            6
+        } else {
+            whole.max(usize::from(got > 0))
+        })
     }
 }
 
@@ -164,7 +168,13 @@ mod tests {
     #[test]
     fn text_rays_across_lines() {
         let (v, w) = all(b"0 0 0\n0 0 1 1 2 3 4\n5 6\n", RayFormat::Ascii);
-        assert_eq!(v, [([0.0; 3], [0.0, 0.0, 1.0]), ([1.0, 2.0, 3.0], [4.0, 5.0, 6.0])]);
+        assert_eq!(
+            v,
+            [
+                ([0.0; 3], [0.0, 0.0, 1.0]),
+                ([1.0, 2.0, 3.0], [4.0, 5.0, 6.0])
+            ]
+        );
         assert!(w.is_none());
     }
 

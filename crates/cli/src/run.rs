@@ -71,10 +71,7 @@ pub fn main_with(run: fn(Vec<String>) -> anyhow::Result<ExitCode>) -> ExitCode {
         .stack_size(crate::threads::STACK_BYTES)
         .spawn(move || run(args))
         .map_err(anyhow::Error::from)
-        .and_then(|h| {
-            h.join()
-                .unwrap_or_else(|p| std::panic::resume_unwind(p))
-        });
+        .and_then(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)));
     match result {
         Ok(code) => code,
         Err(e) => {

@@ -429,10 +429,7 @@ impl<'a> Engine<'a> {
                         } else {
                             let lo = r * c;
                             let hi = (lo + c).min(base + rays.len());
-                            self.accumulate(
-                                (lo..hi).map(|k| (k as u64, rays[k - base])),
-                                scratch,
-                            )
+                            self.accumulate((lo..hi).map(|k| (k as u64, rays[k - base])), scratch)
                         };
                         self.finish(acc, false)
                     },

@@ -431,7 +431,8 @@ pub fn examine_partial(plan: &StreamPlan, format: Format) -> Result<Option<Parti
     if name.starts_with('!') {
         bail!("cannot recover output written to a command ({name})");
     }
-    if fenestra_cli::output::target_kind(Path::new(name))? == fenestra_cli::output::Target::Through {
+    if fenestra_cli::output::target_kind(Path::new(name))? == fenestra_cli::output::Target::Through
+    {
         bail!("cannot recover '{name}': it is a link, pipe or device, written through");
     }
     let rs = record_size(plan, format).context("cannot recover ASCII output")?;

@@ -305,7 +305,10 @@ pub fn decode_text(bytes: Vec<u8>) -> String {
 pub fn decode_text_latin1(bytes: Vec<u8>) -> (String, bool) {
     match String::from_utf8(bytes) {
         Ok(s) => (s, false),
-        Err(e) => (e.into_bytes().iter().map(|&b| char::from(b)).collect(), true),
+        Err(e) => (
+            e.into_bytes().iter().map(|&b| char::from(b)).collect(),
+            true,
+        ),
     }
 }
 

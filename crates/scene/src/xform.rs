@@ -250,13 +250,17 @@ pub fn xform_files(
                     .context("cannot read standard input")?;
                 stdin_text = Some(crate::rad::decode_text_latin1(bytes));
             }
-            let (text, latin1) = stdin_text.as_ref().map_or(("", false), |(t, l)| (t.as_str(), *l));
+            let (text, latin1) = stdin_text
+                .as_ref()
+                .map_or(("", false), |(t, l)| (t.as_str(), *l));
             x.text(text, "-", out)?;
             put(out, latin1)?;
         } else {
             for (f, t) in files.iter().zip(texts.iter_mut()) {
                 if t.is_none() {
-                    *t = Some(crate::rad::decode_text_latin1(crate::rad::read_text_bytes(f)?));
+                    *t = Some(crate::rad::decode_text_latin1(crate::rad::read_text_bytes(
+                        f,
+                    )?));
                 }
                 let (text, latin1) = t.as_ref().map_or(("", false), |(t, l)| (t.as_str(), *l));
                 x.text(text, f, out)?;

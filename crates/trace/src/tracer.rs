@@ -271,18 +271,16 @@ impl Tracer {
             let r = &p.rargs;
             let bad = |what: &str| anyhow::anyhow!("{}: {} '{}': {what}", p.loc, p.ptype, p.name);
             let shape = match p.ptype.as_str() {
-                t if crate::surface::is_geometry(t) => {
-                    match crate::surface::shape_of(p)? {
-                        crate::surface::Built::Shape(shape, warn) => {
-                            warnings.extend(warn);
-                            shape
-                        }
-                        crate::surface::Built::Ignored(warn) => {
-                            warnings.push(warn);
-                            continue;
-                        }
+                t if crate::surface::is_geometry(t) => match crate::surface::shape_of(p)? {
+                    crate::surface::Built::Shape(shape, warn) => {
+                        warnings.extend(warn);
+                        shape
                     }
-                }
+                    crate::surface::Built::Ignored(warn) => {
+                        warnings.push(warn);
+                        continue;
+                    }
+                },
                 "source" => {
                     if r.len() != 4 {
                         return Err(bad("needs 4 real arguments"));
