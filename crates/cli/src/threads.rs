@@ -19,7 +19,7 @@ pub fn pool(n: usize) -> Result<rayon::ThreadPool> {
 /// Threads for a request of `n` processes: an error below 1, capped at the cores
 /// available with a warning.
 pub fn worker_count(n: f64) -> Result<usize> {
-    if !(n >= 1.0) {
+    if n.is_nan() || n < 1.0 {
         bail!("-n {n}: illegal number of processes (at least 1)");
     }
     let cores = std::thread::available_parallelism().map_or(1, |c| c.get());

@@ -268,6 +268,27 @@ fn read_line_limited<R: BufRead + ?Sized>(r: &mut R, out: &mut Vec<u8>) -> std::
     }
 }
 
+/// Text of a header value fit for a message: printable ASCII as it is, anything else
+/// (control bytes, binary garbage, characters outside ASCII) as `\xNN` / `\u{…}` escapes, at
+/// most 80 characters.
+pub fn printable(v: &str) -> String {
+    let mut out = String::new();
+    for (i, c) in v.chars().enumerate() {
+        if i == 80 {
+            out.push('…');
+            break;
+        }
+        if c.is_ascii_graphic() || c == ' ' {
+            out.push(c);
+        } else if (c as u32) < 0x80 {
+            out.push_str(&format!("\\x{:02x}", c as u32));
+        } else {
+            out.push_str(&c.escape_unicode().to_string());
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -343,23 +364,3 @@ mod tests {
     }
 }
 
-/// Text of a header value fit for a message: printable ASCII as it is, anything else
-/// (control bytes, binary garbage, characters outside ASCII) as `\xNN` / `\u{…}` escapes, at
-/// most 80 characters.
-pub fn printable(v: &str) -> String {
-    let mut out = String::new();
-    for (i, c) in v.chars().enumerate() {
-        if i == 80 {
-            out.push('…');
-            break;
-        }
-        if c.is_ascii_graphic() || c == ' ' {
-            out.push(c);
-        } else if (c as u32) < 0x80 {
-            out.push_str(&format!("\\x{:02x}", c as u32));
-        } else {
-            out.push_str(&c.escape_unicode().to_string());
-        }
-    }
-    out
-}
