@@ -363,4 +363,3 @@ mod tests {
         assert!(!is_assignment("=3"));
     }
 }
-
