@@ -654,7 +654,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             seen += 1;
         }
         progress.inc(seen as u64);
-        let (mut base, mut nextflush) = (seen, flush_every);
+        let mut base = seen;
+        let mut schedule = fenestra_cli::rays::FlushSchedule::new(flush_every);
         let mut batch: Vec<InputRay> = Vec::new();
         let mut partial = false;
         loop {
@@ -667,20 +668,9 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 };
                 dummy |= ray.dir == fenestra_trace::DVec3::ZERO;
                 batch.push(ray);
-                if (base + batch.len()) % count == 0 {
-                    if dummy {
-                        flush = true;
-                        nextflush = flush_every;
-                        break;
-                    }
-                    if flush_every > 0 {
-                        nextflush -= 1;
-                        if nextflush == 0 {
-                            flush = true;
-                            nextflush = flush_every;
-                            break;
-                        }
-                    }
+                if (base + batch.len()) % count == 0 && schedule.record_done(dummy) {
+                    flush = true;
+                    break;
                 }
             }
             if batch.is_empty() {

@@ -286,7 +286,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             Fmt::Double => fenestra_cli::rays::RayFormat::Double,
         },
     );
-    let (mut k0, mut wave, mut nextflush) = (0usize, 0usize, flush_every);
+    let (mut k0, mut wave) = (0usize, 0usize);
+    let mut schedule = fenestra_cli::rays::FlushSchedule::new(flush_every);
     let mut bad_rays = 0usize;
     let mut batch: Vec<(DVec3, DVec3)> = Vec::new();
     loop {
@@ -297,25 +298,18 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 break;
             };
             let (org, dir) = (DVec3::from(org), DVec3::from(dir));
-            if !(org.is_finite() && dir.is_finite()) {
+            let dummy = if org.is_finite() && dir.is_finite() {
+                batch.push((org, dir));
+                dir == DVec3::ZERO
+            } else {
                 // answered with zeros (and a warning), never traced into a NaN
                 bad_rays += 1;
                 batch.push((DVec3::ZERO, DVec3::ZERO));
-                continue;
-            }
-            batch.push((org, dir));
-            if dir == DVec3::ZERO {
+                false
+            };
+            if schedule.record_done(dummy) {
                 flush = true;
-                nextflush = flush_every;
                 break;
-            }
-            if flush_every > 0 {
-                nextflush -= 1;
-                if nextflush == 0 {
-                    flush = true;
-                    nextflush = flush_every;
-                    break;
-                }
             }
         }
         if batch.is_empty() {

@@ -147,6 +147,38 @@ impl<R: BufRead> RayReader<R> {
     }
 }
 
+/// When Radiance's renderers flush their output: after every `every` records (`-x`
+/// without a picture's `-y`; 0: never) and after a record holding a dummy
+/// (zero-direction) ray, which also restarts the count.
+#[derive(Debug, Clone, Copy)]
+pub struct FlushSchedule {
+    every: usize,
+    left: usize,
+}
+
+impl FlushSchedule {
+    /// Flushes every `every` records (0: only after dummy rays).
+    pub fn new(every: usize) -> Self {
+        FlushSchedule { every, left: every }
+    }
+
+    /// A record ended (`dummy`: it held a zero-direction ray): whether to flush now.
+    pub fn record_done(&mut self, dummy: bool) -> bool {
+        if dummy {
+            self.left = self.every;
+            return true;
+        }
+        if self.every > 0 {
+            self.left -= 1;
+            if self.left == 0 {
+                self.left = self.every;
+                return true;
+            }
+        }
+        false
+    }
+}
+
 /// Whether every value of a ray is finite.
 pub fn finite(r: &Ray) -> bool {
     r.0.iter().chain(&r.1).all(|x| x.is_finite())
@@ -192,6 +224,18 @@ mod tests {
         assert_eq!(v.len(), 2);
         assert!(!finite(&v[0]) && !finite(&v[1]));
         assert!(w.is_none());
+    }
+
+    #[test]
+    fn flushes_as_radiance() {
+        let mut f = FlushSchedule::new(3);
+        let got: Vec<bool> = [false, false, false, false, true, false, false, false]
+            .iter()
+            .map(|&d| f.record_done(d))
+            .collect();
+        assert_eq!(got, [false, false, true, false, true, false, false, true]);
+        let mut never = FlushSchedule::new(0);
+        assert!(!never.record_done(false) && never.record_done(true));
     }
 
     #[test]

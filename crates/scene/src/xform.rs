@@ -220,6 +220,9 @@ pub fn xform_files(
     let mut stdin_text: Option<(String, bool)> = None;
     let mut texts: Vec<Option<(String, bool)>> = vec![None; files.len()];
     let mut out = String::new();
+    // the first run (array element) is written only once it is whole: every run reads
+    // the same input, so an error shows there and leaves no partial output
+    let mut first: Option<Vec<u8>> = Some(Vec::new());
     for run in opts.array_runs()? {
         let out = &mut out;
         out.clear();
@@ -237,8 +240,11 @@ pub fn xform_files(
         // each input's part of the output is written in its own encoding (a Latin-1
         // file's comments go out byte for byte)
         let mut put = |out: &mut String, latin1: bool| -> Result<()> {
-            sink.write_all(&crate::rad::encode_text(out, latin1))
-                .context("cannot write the output")?;
+            let bytes = crate::rad::encode_text(out, latin1);
+            match first.as_mut() {
+                Some(held) => held.extend_from_slice(&bytes),
+                None => sink.write_all(&bytes).context("cannot write the output")?,
+            }
             out.clear();
             Ok(())
         };
@@ -266,6 +272,9 @@ pub fn xform_files(
                 x.text(text, f, out)?;
                 put(out, latin1)?;
             }
+        }
+        if let Some(held) = first.take() {
+            sink.write_all(&held).context("cannot write the output")?;
         }
     }
     Ok(())
