@@ -1,0 +1,296 @@
+//! Direct lighting: sampling light sources (distant, sphere, flat, cylinder), shadow rays
+//! and their relay through transmitting surfaces.
+
+use super::*;
+
+impl Tracer {
+    /// Direct lighting at `p` (normal `nrm`): `bsdf(l, omega, ldot)` gives the coefficient
+    /// of a source sample; a shadow ray fetches the source's radiance. With source
+    /// thresholding (`-dt > 0`, a [`DirectState`] in `cx`), only the brightest samples are
+    /// shadow-tested ([`Self::direct_threshold`]); `prior` is what the surface already
+    /// returns from its other components (Radiance computes direct light last).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn direct(
+        &self,
+        r: &Ray,
+        p: DVec3,
+        nrm: DVec3,
+        shape: Option<usize>,
+        prior: DVec3,
+        cx: &mut Ctx,
+        bsdf: impl Fn(DVec3, f64, f64) -> DVec3,
+    ) -> DVec3 {
+        let mut val = DVec3::ZERO;
+        if !self.effects.direct {
+            return val;
+        }
+        if cx.ds.is_some() {
+            return self.direct_threshold(r, p, nrm, shape, prior, cx, bsdf);
+        }
+        let skip = shape.filter(|&s| self.accel.shapes[s].is_flat());
+        for si in 0..self.sources.len() {
+            self.each_sample(si, p, shape, r.weight, cx, |cx, s| {
+                let ldot = s.l.dot(nrm);
+                self.shadow(
+                    r,
+                    p,
+                    s.l,
+                    s.tmax,
+                    si,
+                    skip,
+                    bsdf(s.l, s.omega, ldot),
+                    &mut val,
+                    cx,
+                );
+            });
+        }
+        val
+    }
+
+    /// Calls `f` for every sample of source `si` seen from `p` (on surface `shape`): its
+    /// unit direction, solid angle, shadow-ray length and the number of samples drawn
+    /// for the source. Samples are drawn (random numbers used) before the first call.
+    /// `weight` is the weight of the ray that reached `p` (a cylinder's `-ds` subdivision
+    /// depends on it, as in Radiance).
+    pub(super) fn each_sample(
+        &self,
+        si: usize,
+        p: DVec3,
+        shape: Option<usize>,
+        weight: f64,
+        cx: &mut Ctx,
+        mut f: impl FnMut(&mut Ctx, SourceSample),
+    ) {
+        let s = &self.sources[si];
+        match s.geom {
+            SourceGeom::Distant(k) => {
+                let d = &self.distant[k];
+                let l = self.jitter_cone(d.dir, d.cos_half, cx);
+                f(
+                    cx,
+                    SourceSample {
+                        l,
+                        omega: d.omega,
+                        tmax: f64::INFINITY,
+                        count: 1,
+                    },
+                );
+            }
+            SourceGeom::Virtual { base, mirror, dir } => {
+                if Some(mirror) == shape {
+                    return;
+                }
+                let SourceGeom::Distant(k) = self.sources[base].geom else {
+                    return;
+                };
+                let d = &self.distant[k];
+                let l = self.jitter_cone(dir, d.cos_half, cx);
+                f(
+                    cx,
+                    SourceSample {
+                        l,
+                        omega: d.omega,
+                        tmax: f64::INFINITY,
+                        count: 1,
+                    },
+                );
+            }
+            SourceGeom::Local(sh) => {
+                if Some(sh) == shape {
+                    return;
+                }
+                let (maxrad, focus, spot) = match &self.mats[&s.mat] {
+                    Material::Light {
+                        kind: LightKind::Glow(rad),
+                        ..
+                    } => (*rad, 0.0, None),
+                    Material::Light {
+                        kind: LightKind::Spot(cosang, aim, flen),
+                        ..
+                    } => (f64::INFINITY, *flen, Some((*cosang, *aim))),
+                    _ => (f64::INFINITY, 0.0, None),
+                };
+                // `beyond`: how far past the sample point its shadow ray may still meet the
+                // source (a cylinder's sample can lie off its surface)
+                let mut emit = |cx: &mut Ctx, q: DVec3, omega: f64, count: usize, beyond: f64| {
+                    let v = q - p;
+                    let dist = v.length();
+                    if dist <= 0.0 || dist > maxrad || omega <= 0.0 {
+                        return;
+                    }
+                    // a sample outside a spotlight's cone is dropped before any shadow ray
+                    // (as Radiance's srcray; rcontrib would otherwise record the ray)
+                    if let Some((cosang, aim)) = spot {
+                        if -(v / dist).dot(aim) < cosang {
+                            return;
+                        }
+                    }
+                    // a spotlight's light comes from its focus, `focus` behind the source
+                    // (Radiance scales the sample's solid angle so)
+                    let omega = if focus > 0.0 {
+                        omega * (dist / (dist + focus)).powi(2)
+                    } else {
+                        omega
+                    };
+                    f(
+                        cx,
+                        SourceSample {
+                            l: v / dist,
+                            omega,
+                            tmax: dist * (1.0 + 1e-7) + beyond + Self::tmin(q),
+                            count,
+                        },
+                    );
+                };
+                if let Some(cyl) = &s.cyl {
+                    let parts = cyl.partitions(p, self.opts.ds, weight);
+                    let count = parts.len();
+                    let samples: Vec<(DVec3, f64)> = parts
+                        .into_iter()
+                        .filter_map(|(cent, size)| {
+                            let jit = if self.opts.dj > 0.0 {
+                                let u = [cx.rng.next_f64(), cx.rng.next_f64(), cx.rng.next_f64()];
+                                Some((self.opts.dj, u))
+                            } else {
+                                None
+                            };
+                            cyl.sample(p, cent, size, jit)
+                        })
+                        .collect();
+                    for (q, omega) in samples {
+                        emit(cx, q, omega, count, cyl.beyond());
+                    }
+                    return;
+                }
+                if let Some(flat) = &s.flat {
+                    let parts = flat.partitions(p, self.opts.ds, weight);
+                    let count = parts.len();
+                    let samples: Vec<(DVec3, f64)> = parts
+                        .into_iter()
+                        .filter_map(|part| {
+                            let jit = if self.opts.dj > 0.0 {
+                                let u = [cx.rng.next_f64(), cx.rng.next_f64()];
+                                Some((self.opts.dj, u))
+                            } else {
+                                None
+                            };
+                            flat.sample(p, part, count, jit)
+                        })
+                        .collect();
+                    for (q, omega) in samples {
+                        emit(cx, q, omega, count, 0.0);
+                    }
+                    return;
+                }
+                if let Shape::Sphere { c, r, .. } = &self.accel.shapes[sh] {
+                    if let Some(omega) = Self::sphere_omega(*c, *r, p) {
+                        emit(cx, *c, omega, 1, 0.0);
+                    }
+                }
+            }
+        }
+    }
+
+    /// A direction toward a distant source: its centre, or with `-dj` a point jittered
+    /// within the source's cone.
+    pub(super) fn jitter_cone(&self, dir: DVec3, cos_half: f64, cx: &mut Ctx) -> DVec3 {
+        if self.opts.dj <= 0.0 {
+            return dir;
+        }
+        let (u, v) = (cx.rng.next_f64(), cx.rng.next_f64());
+        let ct = 1.0 - self.opts.dj * u * (1.0 - cos_half);
+        let st = (1.0 - ct * ct).max(0.0).sqrt();
+        let (a, b) = frame(dir);
+        let ph = 2.0 * PI * v;
+        (a * (st * ph.cos()) + b * (st * ph.sin()) + dir * ct).normalize()
+    }
+
+    /// A shadow ray meeting a mirror: if it is aimed at that mirror's image of a distant
+    /// source, it continues, reflected, toward the real source (weighted by the mirror's
+    /// colour); any other shadow ray is stopped.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn relay(
+        &self,
+        r: &Ray,
+        shape: usize,
+        p: DVec3,
+        n: DVec3,
+        rod: f64,
+        t: f64,
+        color: DVec3,
+        cx: &mut Ctx,
+    ) -> DVec3 {
+        let Some(SourceGeom::Virtual { base, mirror, .. }) = r.src.map(|s| self.sources[s].geom)
+        else {
+            return DVec3::ZERO;
+        };
+        if mirror != shape {
+            return DVec3::ZERO;
+        }
+        let nrm = if rod < 0.0 { -n } else { n };
+        let dir = (r.dir + nrm * (2.0 * rod.abs())).normalize();
+        let SourceGeom::Distant(k) = self.sources[base].geom else {
+            return DVec3::ZERO;
+        };
+        if self.distant[k].dir.dot(nrm) <= 0.0 {
+            return DVec3::ZERO;
+        }
+        let mut c = self.child(r, p, dir, 0, color, Some(shape), t);
+        c.weight = r.weight;
+        c.src = Some(base);
+        color * self.trace(&c, cx)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn shadow(
+        &self,
+        r: &Ray,
+        p: DVec3,
+        l: DVec3,
+        tmax: f64,
+        si: usize,
+        skip: Option<usize>,
+        coef: DVec3,
+        val: &mut DVec3,
+        cx: &mut Ctx,
+    ) {
+        // as Radiance's direct(): any sample with a positive coefficient is tested (a
+        // grazing part of a subdivided source can have a coefficient below 1e-6)
+        if maxc(coef) <= 0.0 {
+            return;
+        }
+        let c = self.shadow_ray(r, p, l, tmax, si, skip, coef);
+        *val += coef * self.trace(&c, cx);
+    }
+
+    /// The shadow ray from `p` (on surface `skip`, if flat) along `l` toward source `si`,
+    /// `tmax` long, with coefficient `coef`. Radiance starts shadow rays without a
+    /// coefficient: they keep the parent's weight and are never subject to Russian
+    /// roulette.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn shadow_ray(
+        &self,
+        r: &Ray,
+        p: DVec3,
+        l: DVec3,
+        tmax: f64,
+        si: usize,
+        skip: Option<usize>,
+        coef: DVec3,
+    ) -> Ray {
+        let mut c = self.child(r, p, l, SHADOW, coef, skip, 0.0);
+        c.weight = r.weight;
+        c.src = Some(si);
+        c.tmax = tmax;
+        c
+    }
+
+    /// Solid angle of a sphere (centre `c`, radius `r`) seen from `p` outside it.
+    pub(super) fn sphere_omega(c: DVec3, r: f64, p: DVec3) -> Option<f64> {
+        let d2 = (c - p).length_squared();
+        if d2 <= r * r {
+            return None;
+        }
+        Some(2.0 * PI * (1.0 - (1.0 - r * r / d2).max(0.0).sqrt()))
+    }
+}
