@@ -5,9 +5,10 @@
 use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
-use fenestra_contrib::calc::{is_zero_constant, parse_params, BinRequest, Bins, CalcDefs};
-use fenestra_contrib::engine::{Engine, InFormat, InputRay, RayInput, Record, RunOptions, Tracked};
+use fenestra_contrib::bins::{is_zero_constant, parse_params, BinRequest, Bins, CalcDefs};
+use fenestra_contrib::engine::{Engine, InFormat, InputRay, RayInput, RunOptions, Tracked};
 use fenestra_contrib::output::{self, Format, HeaderInfo, ModOut, Spec, Stream};
+use fenestra_contrib::run as contrib_run;
 use fenestra_trace::{TraceOptions, Tracer};
 
 /// Most bins one modifier may have (2^24: 400 MiB of sums per thread).
@@ -418,34 +419,28 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     };
     let pool = fenestra_cli::threads::pool(nproc)?;
 
+    let opts = RunOptions {
+        irradiance_at_hit: irr_hit,
+        limit_dist: limit,
+        irradiance: irr,
+        value,
+        count,
+        errors,
+        batches,
+    };
     // rtcontrib without -bn: a first pass over the input finds the bins each such
-    // modifier reaches (rays are seeded by index, so the second pass meets the same ones)
+    // modifier reaches
     if dynamic {
-        let probe_opts = RunOptions {
-            irradiance_at_hit: irr_hit,
-            limit_dist: limit,
-            irradiance: irr,
-            value,
-            // the same random streams as the main pass: replicas with -E -c 1, ray
-            // indices otherwise (-c 0 is probed in records of 256 rays)
-            count: if count == 0 { 256 } else { count },
-            errors,
-            batches,
+        let flags: Vec<bool> = mods.iter().map(|m| m.dynamic).collect();
+        let cx = contrib_run::Context {
+            tracer: &tracer,
+            bins: &bins,
+            nprims: scene.prims.len(),
+            pool: &pool,
         };
-        let probe = Engine::new(&tracer, &bins, scene.prims.len(), &tracked, probe_opts);
-        let c = if count == 0 { 256 } else { count };
-        let nrec = rays.len().div_ceil(c);
-        let mut r = 0;
-        while r < nrec {
-            let n = 256.min(nrec - r);
-            probe.records(&rays, 0, r, n, &pool)?;
-            r += n;
-        }
-        for (m, b) in probe.take_bad_bins() {
-            if mods[m].dynamic {
-                mods[m].nbins = mods[m].nbins.max(b as usize + 1);
-                tracked[m].nbins = mods[m].nbins;
-            }
+        contrib_run::probe_bins(&cx, &mut tracked, &flags, &rays, &opts)?;
+        for (m, t) in mods.iter_mut().zip(&tracked) {
+            m.nbins = t.nbins;
         }
     }
 
@@ -560,154 +555,66 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             None => Stream::open(p, info),
         }
     };
-    let mut streams: Vec<Stream> = plans
+    let values: Vec<Stream> = plans
         .into_iter()
         .enumerate()
         .map(|(k, p)| open(k, p, &info))
         .collect::<Result<_>>()?;
-    let mut err_streams: Vec<Stream> = err_plans
+    let err_streams: Vec<Stream> = err_plans
         .into_iter()
         .enumerate()
         .map(|(k, p)| open(nplans + k, p, &err_info))
         .collect::<Result<_>>()?;
-
-    let opts = RunOptions {
-        irradiance_at_hit: irr_hit,
-        limit_dist: limit,
-        irradiance: irr,
-        value,
-        count,
-        errors,
-        batches,
+    let mut out = contrib_run::Outputs {
+        values,
+        errors: err_streams,
+        format: fout,
     };
+
     let engine = Engine::new(&tracer, &bins, scene.prims.len(), &tracked, opts);
     let progress = fenestra_cli::progress::Progress::new(
         expect.unwrap_or(rays.len()) as u64,
         fenestra_cli::prog(),
     );
-    let write = |rec: &Record, streams: &mut [Stream], err_streams: &mut [Stream]| -> Result<()> {
-        for s in streams.iter_mut() {
-            s.write_record(fout, rec.scale, |m, b| {
-                let k = engine.slot(m, b) * 3;
-                [rec.sums[k], rec.sums[k + 1], rec.sums[k + 2]]
-            })?;
-        }
-        if let Some(e) = &rec.errors {
-            for s in err_streams.iter_mut() {
-                s.write_record(fout, 1.0, |m, b| {
-                    let k = engine.slot(m, b) * 3;
-                    [e[k], e[k + 1], e[k + 2]]
-                })?;
-            }
-        }
-        Ok(())
-    };
+    let inc = |n: u64| progress.inc(n);
     let mut total_rays = rays.len();
+    let mut partial = false;
     if count == 0 {
-        let dummies = rays
-            .iter()
-            .filter(|r| r.dir == fenestra_trace::DVec3::ZERO)
-            .count();
-        if dummies > 0 && warnings {
+        if warnings && rays.iter().any(|r| r.dir == fenestra_trace::DVec3::ZERO) {
             fenestra_cli::warn("dummy ray(s) ignored during accumulation");
         }
-        let mut rec = engine.sum_all(&rays, &pool, &|n| progress.inc(n))?;
-        // -r: the sums the files hold are added to this run's
-        for (s, prev) in streams.iter().zip(&previous) {
-            let Some(p) = prev else { continue };
-            for (&(m, b), v) in s.plan.items.iter().zip(p) {
-                let k = engine.slot(m, b) * 3;
-                for (sum, x) in rec.sums[k..k + 3].iter_mut().zip(v) {
-                    *sum += x / rec.scale;
-                }
-            }
-        }
-        write(&rec, &mut streams, &mut err_streams)?;
+        contrib_run::sum_run(&engine, &rays, &previous, &pool, &mut out, &inc)?;
     } else if buffered {
-        let nrec = rays.len().div_ceil(count);
-        if rays.len() % count != 0 && warnings {
-            fenestra_cli::warn("partial accumulation in final record");
-        }
-        let block = (8192 / count).max(32 * nproc).max(1);
-        let mut r = (done_records as usize).min(nrec);
-        progress.inc(((r * count).min(rays.len())) as u64);
-        while r < nrec {
-            let n = block.min(nrec - r);
-            let recs = engine.records(&rays, 0, r, n, &pool)?;
-            for rec in &recs {
-                write(rec, &mut streams, &mut err_streams)?;
-            }
-            let lo = r * count;
-            let hi = ((r + n) * count).min(rays.len());
-            progress.inc((hi - lo) as u64);
-            r += n;
-        }
+        partial = contrib_run::buffered_run(
+            &engine,
+            &rays,
+            count,
+            done_records as usize,
+            &pool,
+            &mut out,
+            &inc,
+        )?;
     } else {
-        // records streamed in batches; Radiance's flushing: after every -x records unless
-        // -y makes a picture with lines of -x > 1 records, and after a record holding a
-        // dummy (zero-direction) ray
-        let flush_every = if yres > 0 && xres > 1 { 0 } else { xres };
-        let block = (8192 / count).max(32 * nproc).max(1);
-        let skip = done_records as usize * count;
-        let mut seen = 0usize;
-        while seen < skip && input.next_ray()?.is_some() {
-            seen += 1;
-        }
-        progress.inc(seen as u64);
-        let mut base = seen;
-        let mut schedule = fenestra_cli::rays::FlushSchedule::new(flush_every);
-        let mut batch: Vec<InputRay> = Vec::new();
-        let mut partial = false;
-        loop {
-            batch.clear();
-            let mut flush = false;
-            let mut dummy = false;
-            while batch.len() < block * count && expect.is_none_or(|e| base + batch.len() < e) {
-                let Some(ray) = input.next_ray()? else {
-                    break;
-                };
-                dummy |= ray.dir == fenestra_trace::DVec3::ZERO;
-                batch.push(ray);
-                if (base + batch.len()) % count == 0 && schedule.record_done(dummy) {
-                    flush = true;
-                    break;
-                }
-            }
-            if batch.is_empty() {
-                break;
-            }
-            partial = (base + batch.len()) % count != 0;
-            let first = base / count;
-            let n = batch.len().div_ceil(count);
-            let recs = engine.records(&batch, base, first, n, &pool)?;
-            for rec in &recs {
-                write(rec, &mut streams, &mut err_streams)?;
-            }
-            if flush {
-                for s in streams.iter_mut().chain(err_streams.iter_mut()) {
-                    s.flush()?;
-                }
-            }
-            progress.inc(batch.len() as u64);
-            base += batch.len();
-            if partial || expect.is_some_and(|e| base >= e) {
-                break;
-            }
-        }
-        if partial && warnings {
-            fenestra_cli::warn("partial accumulation in final record");
-        }
-        total_rays = base;
+        let plan = contrib_run::StreamPlan {
+            count,
+            flush_every: if yres > 0 && xres > 1 { 0 } else { xres },
+            expect,
+            skip_records: done_records as usize,
+        };
+        let end = contrib_run::streamed_run(&engine, &mut input, plan, &pool, &mut out, &inc)?;
+        total_rays = end.rays;
+        partial = end.partial;
     }
     progress.finish();
+    if partial && warnings {
+        fenestra_cli::warn("partial accumulation in final record");
+    }
     if warnings {
         for (_, b) in engine.take_bad_bins() {
             fenestra_cli::warn(format!("bad bin number ({b} ignored)"));
         }
     }
-    for s in streams.into_iter().chain(err_streams) {
-        s.finish()?;
-    }
+    out.finish()?;
     for msg in input.take_warnings() {
         fenestra_cli::warn(msg);
     }

@@ -10,7 +10,7 @@ use fenestra_calc::State;
 use fenestra_trace::{Contribution, DVec3, Tracer};
 use rayon::prelude::*;
 
-use crate::calc::Bins;
+use crate::bins::Bins;
 
 /// Input data format (`-fi`).
 pub use fenestra_cli::rays::RayFormat as InFormat;

@@ -2,8 +2,9 @@
 //! expressions, `-c` accumulation, output streams and headers, Monte Carlo standard errors)
 //! and the Klems window sampler behind genklemsamp.
 
-pub mod calc;
+pub mod bins;
 pub mod engine;
 pub mod klemsamp;
 pub mod native;
 pub mod output;
+pub mod run;
