@@ -1,0 +1,135 @@
+//! The `-f` output formats and `-o` specs with their `%s`/`%d` fields.
+
+use anyhow::{bail, Result};
+
+/// Output data format (`-fXo`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// Text, `%.6e` and a tab per value.
+    Ascii,
+    /// 32-bit floats, native byte order.
+    Float,
+    /// 64-bit floats, native byte order.
+    Double,
+    /// RGBE, 4 bytes per bin.
+    Rgbe,
+}
+
+impl Format {
+    /// The format letter's meaning (`a f d c`).
+    pub fn from_letter(c: char, output: bool) -> Result<Format> {
+        Ok(match c {
+            'a' => Format::Ascii,
+            'f' => Format::Float,
+            'd' => Format::Double,
+            'c' if output => Format::Rgbe,
+            _ => bail!("Illegal i/o format '{c}' (input: a, f, d; output: a, f, d, c)"),
+        })
+    }
+
+    pub(super) fn header_name(self) -> &'static str {
+        match self {
+            Format::Ascii => "ascii",
+            Format::Float => "float",
+            Format::Double => "double",
+            Format::Rgbe => "32-bit_rle_rgbe",
+        }
+    }
+}
+
+/// A parsed `-o` spec: where its `%s` and bin field are.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Spec {
+    /// The spec text.
+    pub text: String,
+    /// Has a `%s` field.
+    pub has_mod: bool,
+    /// Has a bin field (`%d`, `%03d`, `%x` …).
+    pub has_bin: bool,
+}
+
+impl Spec {
+    /// Parses a spec; any conversion other than one `%s` and one integer field is an error.
+    pub fn parse(text: &str) -> Result<Spec> {
+        let (mut has_mod, mut has_bin) = (false, false);
+        let b: Vec<char> = text.chars().collect();
+        let mut i = 0;
+        while i < b.len() {
+            if b[i] == '%' {
+                i += 1;
+                if b.get(i) == Some(&'%') {
+                    i += 1;
+                    continue;
+                }
+                let start = i;
+                while i < b.len() && (b[i].is_ascii_digit() || b[i] == '-' || b[i] == '+') {
+                    i += 1;
+                }
+                let flags: String = b[start..i].iter().collect();
+                fenestra_cli::printf::check_width(text, flags.trim_start_matches(['-', '+', '0']))?;
+                match b.get(i) {
+                    Some('s') if !has_mod => has_mod = true,
+                    Some('d' | 'i' | 'o' | 'x' | 'X') if !has_bin => has_bin = true,
+                    _ => bail!("bad output format '{text}' (one %s and one %d field allowed)"),
+                }
+            }
+            i += 1;
+        }
+        Ok(Spec {
+            text: text.to_string(),
+            has_mod,
+            has_bin,
+        })
+    }
+
+    /// The destination name for a modifier and bin.
+    pub fn expand(&self, modifier: &str, bin: usize) -> String {
+        let b: Vec<char> = self.text.chars().collect();
+        let mut out = String::new();
+        let mut i = 0;
+        while i < b.len() {
+            if b[i] != '%' {
+                out.push(b[i]);
+                i += 1;
+                continue;
+            }
+            i += 1;
+            if b.get(i) == Some(&'%') {
+                out.push('%');
+                i += 1;
+                continue;
+            }
+            let start = i;
+            while i < b.len() && (b[i].is_ascii_digit() || b[i] == '-' || b[i] == '+') {
+                i += 1;
+            }
+            let flags: String = b[start..i].iter().collect();
+            let left = flags.contains('-');
+            let zero = flags.trim_start_matches(['-', '+']).starts_with('0');
+            let width: usize = flags
+                .trim_start_matches(['-', '+', '0'])
+                .parse()
+                .unwrap_or(0);
+            let body = match b.get(i) {
+                Some('s') => modifier.to_string(),
+                Some('o') => format!("{bin:o}"),
+                Some('x') => format!("{bin:x}"),
+                Some('X') => format!("{bin:X}"),
+                _ => bin.to_string(),
+            };
+            i += 1;
+            let pad = width.saturating_sub(body.chars().count());
+            if left {
+                out.push_str(&body);
+                out.push_str(&" ".repeat(pad));
+            } else if zero && !matches!(b.get(i - 1), Some('s')) {
+                out.push_str(&"0".repeat(pad));
+                out.push_str(&body);
+            } else {
+                out.push_str(&" ".repeat(pad));
+                out.push_str(&body);
+            }
+        }
+        out
+    }
+}
