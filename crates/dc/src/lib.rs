@@ -1,4 +1,5 @@
 //! fenestra-dc: daylight-coefficient algebra (V·T·D·s time stepping) and the matrix operations behind rmtxop.
 
 pub mod ops;
+pub mod steps;
 pub mod timestep;
