@@ -1,9 +1,6 @@
 //! dctimestep: daylight-coefficient time stepping, `V·T·D·s` or `DC·s`, with the
 //! sky given as a vector or a matrix of time steps (see docs/tools/dctimestep.md).
 
-// Per-channel colour arithmetic reads most clearly with explicit indices.
-#![allow(clippy::needless_range_loop)]
-
 use std::process::ExitCode;
 
 use anyhow::{bail, Result};

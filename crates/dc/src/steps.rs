@@ -70,8 +70,8 @@ pub fn load_t(name: &str) -> Result<Planar> {
             fenestra_bsdf::radiance::transmission_matrix(&b).map_err(|e| anyhow!("{name}: {e}"))?;
         let mut p = Planar::zeros(m.rows, m.cols);
         for (i, v) in m.data.iter().enumerate() {
-            for c in 0..3 {
-                p.data[c][i] = v[c];
+            for (plane, x) in p.data.iter_mut().zip(v) {
+                plane[i] = *x;
             }
         }
         return Ok(p);
@@ -600,13 +600,13 @@ pub fn picture_form(
     for t in 0..steps {
         let mut sum: Vec<[f64; 3]> = Vec::new();
         let mut any = false;
-        for r in 0..nimg {
+        for (r, slot) in cache.iter_mut().enumerate() {
             let c = [coef(r, t, 0), coef(r, t, 1), coef(r, t, 2)];
             let last = r + 1 == nimg;
             if c == [0.0; 3] && !(last && !any && dims.is_none()) {
                 continue;
             }
-            if cache[r].is_none() {
+            if slot.is_none() {
                 let name = fenestra_cli::printf::format_int_field(vspec, r)?;
                 let mut rd = fenestra_cli::input::open(&name)?;
                 let p = Picture::read(&mut rd, "dctimestep").map_err(|e| anyhow!("{name}: {e}"))?;
@@ -621,9 +621,9 @@ pub fn picture_form(
                     Some(_) => {}
                     None => dims = Some((p.res, name.clone())),
                 }
-                cache[r] = Some(p);
+                *slot = Some(p);
             }
-            let p = cache[r].as_ref().expect("cached picture");
+            let p = slot.as_ref().expect("cached picture");
             if sum.is_empty() {
                 sum = vec![[0.0; 3]; p.pixels.len()];
             }
