@@ -4,30 +4,8 @@ use std::io::Write;
 use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
+use fenestra_trace::waves::Waves;
 use fenestra_trace::{DVec3, TraceOptions, Tracer};
-use rayon::prelude::*;
-
-/// Source thresholding (`-dt > 0`) carries shadow-test statistics over the whole run, as
-/// Radiance does, deterministically for any `-n`: records are traced in blocks (one thread
-/// traces a block's records in order) and blocks in waves of 1, 1, 2, 4, 8, then
-/// `WAVE_MAX` blocks; every block of a wave starts from the statistics of all earlier
-/// waves, merged in record order. A block is `BLOCK_AB0` records with `-ab 0` (cheap
-/// records: the first 32 follow each other exactly), one record with `-ab > 0` (each record
-/// traces many rays: they spread over the threads).
-const BLOCK_AB0: usize = 16;
-const WAVE_MAX: usize = 16;
-
-/// Blocks in wave `w` (0, 1, …) of a thresholded run: 1, then doubling from 1 up to
-/// [`WAVE_MAX`].
-fn wave_width(w: usize) -> usize {
-    if w == 0 {
-        1
-    } else {
-        (1usize << (w - 1).min(16)).min(WAVE_MAX)
-    }
-}
-/// Records per parallel batch without thresholding.
-const CHUNK: usize = 1024;
 
 const USAGE: &str = "[-I|-i][-o{o,d,v,w,l,L,p,n,N}][-f{a,f,d}{a,f,d}][-h][-x N][-y N][-n N][-ab N][-ad N][-aa V][-ar N][-as N][-av r g b][-lw W][-lr N][-ds V][-dj V][-dc V][-dr N][-dt V][-st V][-ss V][-bv][-u][-v][-full][-seed N] scene.{rad,oct}…";
 
@@ -178,29 +156,25 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     for w in tracer.warnings() {
         fenestra_cli::warn(w);
     }
-    // With source thresholding the statistics are carried over the run: records in blocks
-    // (`block` consecutive records traced in order by one thread), blocks in waves of
-    // `wave_width` blocks, each block forked from the state merged from all earlier waves.
-    let thresholding = tracer.thresholding();
-    let block = if thresholding && o.ab == 0 {
-        BLOCK_AB0
-    } else {
-        1
-    };
+    // With source thresholding the statistics are carried over the run, deterministically
+    // for any -n (fenestra_trace::waves)
+    let mut waves = Waves::new(&tracer, o.ab);
+    let (thresholding, block) = (waves.thresholding(), waves.block());
     if verbose {
         for n in &tracer.effects().notes {
             eprintln!("{}: {n}", fenestra_cli::prog());
         }
         if thresholding {
             let growing: Vec<String> = (0..)
-                .map(wave_width)
-                .take_while(|&w| w < WAVE_MAX)
+                .map(fenestra_trace::waves::wave_width)
+                .take_while(|&w| w < fenestra_trace::waves::WAVE_MAX)
                 .map(|w| w.to_string())
                 .collect();
             eprintln!(
-                "{}: source thresholding: hit statistics and obstructor caches carried over the run, in blocks of {block} record(s) traced in waves of {}, then {WAVE_MAX} blocks (each block starts from all earlier waves)",
+                "{}: source thresholding: hit statistics and obstructor caches carried over the run, in blocks of {block} record(s) traced in waves of {}, then {} blocks (each block starts from all earlier waves)",
                 fenestra_cli::prog(),
-                growing.join(", ")
+                growing.join(", "),
+                fenestra_trace::waves::WAVE_MAX
             );
         }
     }
@@ -233,7 +207,6 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     }
     let pool = fenestra_cli::threads::pool(nproc)?;
     let progress = fenestra_cli::progress::Progress::new(expect as u64, "rtrace");
-    let mut base = tracer.direct_state();
     let wants_hit = outspec.chars().any(|c| "lLpnN".contains(c));
     let record = |k: usize, (org, dir): (DVec3, DVec3), st: &mut fenestra_trace::DirectState| {
         let mut rec = Vec::new();
@@ -269,14 +242,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         }
         rec
     };
-    // Rays are read and traced in batches; a batch ends early where Radiance flushes. The
-    // thresholding waves end on batch ends: a full batch is a whole number of the widest
-    // waves, so without flushes the waves are those of one pass over all rays.
-    let batch_max = if thresholding {
-        64 * WAVE_MAX * block
-    } else {
-        CHUNK * 8
-    };
+    // Rays are read and traced in batches; a batch ends early where Radiance flushes.
+    let batch_max = waves.batch_max();
     let stdin = std::io::stdin();
     let mut reader = fenestra_cli::rays::RayReader::new(
         std::io::BufReader::with_capacity(1 << 16, stdin.lock()),
@@ -286,7 +253,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             Fmt::Double => fenestra_cli::rays::RayFormat::Double,
         },
     );
-    let (mut k0, mut wave) = (0usize, 0usize);
+    let mut k0 = 0usize;
     let mut schedule = fenestra_cli::rays::FlushSchedule::new(flush_every);
     let mut bad_rays = 0usize;
     let mut batch: Vec<(DVec3, DVec3)> = Vec::new();
@@ -316,42 +283,18 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             break;
         }
         let n = batch.len();
-        let mut start = 0usize;
-        while start < n {
-            let width = if thresholding {
-                wave_width(wave)
-            } else {
-                CHUNK
-            };
-            let end = (start + width * block).min(n);
-            let blocks: Vec<(Vec<Vec<f64>>, fenestra_trace::DirectState)> = pool.install(|| {
-                (start..end)
-                    .step_by(block)
-                    .collect::<Vec<_>>()
-                    .into_par_iter()
-                    .map(|b| {
-                        let mut st = base.fork();
-                        let recs = (b..(b + block).min(end))
-                            .map(|k| record(k0 + k, batch[k], &mut st))
-                            .collect();
-                        (recs, st)
-                    })
-                    .collect()
-            });
-            let (vals, states): (Vec<Vec<Vec<f64>>>, Vec<fenestra_trace::DirectState>) =
-                blocks.into_iter().unzip();
-            if thresholding {
-                // all of a wave at once: the blocks' states are dropped before their changes
-                // are applied, so the cache cells they shared are not copied
-                base.merge(states);
-            }
-            for rec in vals.into_iter().flatten() {
-                write_record(&mut w, fout, &rec)?;
-            }
-            progress.inc((end - start) as u64);
-            start = end;
-            wave += 1;
-        }
+        waves.run(
+            &pool,
+            &batch,
+            |k, &ray, st| record(k, ray, st),
+            |recs| {
+                for rec in &recs {
+                    write_record(&mut w, fout, rec)?;
+                }
+                progress.inc(recs.len() as u64);
+                Ok(())
+            },
+        )?;
         k0 += n;
         if flush {
             w.flush()?;
@@ -421,13 +364,6 @@ fn fmt_e(v: f64) -> String {
 
 #[cfg(test)]
 mod tests {
-    #[test]
-    fn waves_grow_to_the_most() {
-        let w: Vec<usize> = (0..8).map(super::wave_width).collect();
-        assert_eq!(w, [1, 1, 2, 4, 8, 16, 16, 16]);
-        assert_eq!(super::wave_width(usize::MAX), super::WAVE_MAX);
-    }
-
     #[test]
     fn c_style_exponent() {
         assert_eq!(super::fmt_e(1.23456789), "1.234568e+00");

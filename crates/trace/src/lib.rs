@@ -23,6 +23,7 @@ pub mod rng;
 pub mod shape;
 pub mod surface;
 pub mod tracer;
+pub mod waves;
 
 pub use glam::DVec3;
 pub use options::TraceOptions;
