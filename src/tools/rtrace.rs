@@ -332,7 +332,7 @@ fn write_record(w: &mut impl Write, fout: Fmt, rec: &[f64]) -> Result<()> {
         Fmt::Ascii => {
             let mut s = String::new();
             for v in rec {
-                s.push_str(&format!("{}\t", fmt_e(*v)));
+                s.push_str(&format!("{}\t", fenestra_cfmt::fmt_e(*v, 6)));
             }
             s.push('\n');
             w.write_all(s.as_bytes())?;
@@ -349,25 +349,4 @@ fn write_record(w: &mut impl Write, fout: Fmt, rec: &[f64]) -> Result<()> {
         }
     }
     Ok(())
-}
-
-/// C's `%e` (6 digits after the point, exponent with sign and at least two digits).
-fn fmt_e(v: f64) -> String {
-    if !v.is_finite() {
-        return format!("{v}");
-    }
-    let s = format!("{v:.6e}");
-    let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
-    let e: i32 = e.parse().unwrap_or(0);
-    format!("{m}e{}{:02}", if e < 0 { '-' } else { '+' }, e.abs())
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn c_style_exponent() {
-        assert_eq!(super::fmt_e(1.23456789), "1.234568e+00");
-        assert_eq!(super::fmt_e(1e10), "1.000000e+10");
-        assert_eq!(super::fmt_e(-2.5e-7), "-2.500000e-07");
-    }
 }

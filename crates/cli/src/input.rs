@@ -1,7 +1,7 @@
 //! Opening inputs the Radiance way: a file, `-` for standard input, or `!command`.
 
 use std::io::{BufRead, BufReader, Read};
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, Stdio};
 
 use anyhow::{Context, Result};
 
@@ -15,9 +15,7 @@ pub fn open(name: &str) -> Result<Box<dyn BufRead + Send>> {
         )));
     }
     if let Some(cmd) = name.strip_prefix('!') {
-        let mut child = Command::new("sh")
-            .arg("-c")
-            .arg(cmd)
+        let mut child = fenestra_cfmt::sh_c(cmd)
             .stdin(Stdio::null())
             .stdout(Stdio::piped())
             .spawn()

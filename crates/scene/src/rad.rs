@@ -2,7 +2,7 @@
 //! statement comments and `!command` lines.
 
 use std::fmt::Write as _;
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 use std::sync::Arc;
 
 use anyhow::{anyhow, bail, Context, Result};
@@ -266,9 +266,7 @@ pub(crate) fn command_output(cmd: &str) -> Result<String> {
     if let Some(out) = crate::xform::run_inline(cmd)? {
         return Ok(out);
     }
-    let out = Command::new("sh")
-        .arg("-c")
-        .arg(cmd)
+    let out = fenestra_cfmt::sh_c(cmd)
         .stdin(Stdio::null())
         .stderr(Stdio::inherit())
         .output()

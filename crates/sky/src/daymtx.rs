@@ -265,52 +265,7 @@ pub fn sun_text(step: &Step, dir_illum: f64, good: bool, sun_color: [f32; 3]) ->
     )
 }
 
-/// C's `%.{prec}e` (two-digit exponent at least).
-pub fn fmt_e(v: f64, prec: usize) -> String {
-    let s = format!("{:.*e}", prec, v);
-    let (m, e) = s.split_once('e').expect("exponent");
-    let (sign, digits) = match e.strip_prefix('-') {
-        Some(d) => ('-', d),
-        None => ('+', e),
-    };
-    format!("{m}e{sign}{digits:0>2}")
-}
-
-/// C's `%.{prec}g`.
-pub fn fmt_g(v: f64, prec: usize) -> String {
-    if v == 0.0 {
-        return if v.is_sign_negative() { "-0" } else { "0" }.to_string();
-    }
-    if !v.is_finite() {
-        return if v.is_nan() {
-            "nan".into()
-        } else if v > 0.0 {
-            "inf".into()
-        } else {
-            "-inf".into()
-        };
-    }
-    let p = prec.max(1);
-    let s = format!("{:.*e}", p - 1, v);
-    let (m, e) = s.split_once('e').expect("exponent");
-    let exp: i32 = e.parse().expect("exponent digits");
-    if exp < -4 || exp >= p as i32 {
-        let m = trim_zeros(m);
-        let (sign, d) = if exp < 0 { ('-', -exp) } else { ('+', exp) };
-        format!("{m}e{sign}{d:02}")
-    } else {
-        let decimals = (p as i32 - 1 - exp).max(0) as usize;
-        trim_zeros(&format!("{:.*}", decimals, v)).to_string()
-    }
-}
-
-fn trim_zeros(s: &str) -> &str {
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.')
-    } else {
-        s
-    }
-}
+pub use fenestra_cfmt::{fmt_e, fmt_g};
 
 #[cfg(test)]
 mod tests {

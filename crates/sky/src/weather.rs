@@ -104,47 +104,8 @@ fn date_ok(month: i32, day: i32, hour: f32) -> bool {
     (1..=12).contains(&month) && (0.0..=24.0).contains(&hour) && day >= 1 && day <= days_in(month)
 }
 
-/// Leading number of a word as C's `atof`/`strtod` reads it (0 if none).
-pub fn atof(s: &str) -> f64 {
-    let s = s.trim_start();
-    let b = s.as_bytes();
-    let mut end = 0;
-    let mut best = 0;
-    if end < b.len() && (b[end] == b'+' || b[end] == b'-') {
-        end += 1;
-    }
-    let mut digits = false;
-    while end < b.len() && b[end].is_ascii_digit() {
-        end += 1;
-        digits = true;
-        best = end;
-    }
-    if end < b.len() && b[end] == b'.' {
-        end += 1;
-        while end < b.len() && b[end].is_ascii_digit() {
-            end += 1;
-            digits = true;
-            best = end;
-        }
-    }
-    if digits && end < b.len() && (b[end] == b'e' || b[end] == b'E') {
-        let mut e = end + 1;
-        if e < b.len() && (b[e] == b'+' || b[e] == b'-') {
-            e += 1;
-        }
-        let st = e;
-        while e < b.len() && b[e].is_ascii_digit() {
-            e += 1;
-        }
-        if e > st {
-            best = e;
-        }
-    }
-    if !digits {
-        return 0.0;
-    }
-    s[..best].parse().unwrap_or(0.0)
-}
+/// Leading number of a word as C's `atof` reads it (0 if none).
+pub use fenestra_cfmt::atof;
 
 fn parse_f32(w: &str) -> Option<f32> {
     w.parse::<f32>().ok().filter(|v| v.is_finite())

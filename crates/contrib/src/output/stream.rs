@@ -4,7 +4,7 @@
 use super::*;
 
 use std::io::Write;
-use std::process::{Child, ChildStdin, Command, Stdio};
+use std::process::{Child, ChildStdin, Stdio};
 
 use anyhow::{bail, Context, Result};
 
@@ -46,9 +46,7 @@ impl Stream {
             )),
             Some(n) if n.starts_with('!') => {
                 let cmd = &n[1..];
-                let mut child = Command::new("sh")
-                    .arg("-c")
-                    .arg(cmd)
+                let mut child = fenestra_cfmt::sh_c(cmd)
                     .stdin(Stdio::piped())
                     .spawn()
                     .with_context(|| format!("cannot run output command '{cmd}'"))?;
