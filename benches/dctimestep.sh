@@ -8,7 +8,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 runs=${1:-5}
-set -a; . .oracle/env 2>/dev/null || . /work/main/.oracle/env; set +a
+[ -f .oracle/env ] || scripts/oracle.sh > /dev/null
+set -a; . .oracle/env; set +a
 export FENESTRA_NO_PROGRESS=1
 bin=$(realpath "${CARGO_TARGET_DIR:-target}/testopt")
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT

@@ -11,11 +11,12 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 runs=${1:-3}
 which=${2:-VD}
-set -a; . .oracle/env 2>/dev/null || . /work/main/.oracle/env; set +a
+[ -f .oracle/env ] || scripts/oracle.sh > /dev/null
+set -a; . .oracle/env; set +a
 export FENESTRA_NO_PROGRESS=1
 bin=$(realpath "${CARGO_TARGET_DIR:-target}/testopt")
 lib=$(realpath lib)
-ref=/work/shared/reference/threephase
+ref=${FENESTRA_SHARED:-$(cd .. && pwd)/shared}/reference/threephase
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 cp "$ref"/{materials.rad,room.rad,exterior.rad,window_vmx.rad,window_out.rad,sky_dmx.rad,sensors.pts} "$tmp/"
 cd "$tmp"

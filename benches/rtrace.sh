@@ -6,10 +6,11 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 runs=${1:-3}
-set -a; . .oracle/env 2>/dev/null || . /work/main/.oracle/env; set +a
+[ -f .oracle/env ] || scripts/oracle.sh > /dev/null
+set -a; . .oracle/env; set +a
 export FENESTRA_NO_PROGRESS=1
 ours=$(realpath "${CARGO_TARGET_DIR:-target}/testopt/rtrace")
-ref=/work/shared/reference/threephase
+ref=${FENESTRA_SHARED:-$(cd .. && pwd)/shared}/reference/threephase
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 cp "$ref"/{materials.rad,room.rad,exterior.rad,window_bsdf.rad,skyfunc_glow.rad,sensors.pts,sky_t1_mar21_1000_clear.rad} tests/fixtures/threephase/blinds_kf.xml "$tmp/"
 cd "$tmp"

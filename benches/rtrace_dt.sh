@@ -10,7 +10,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 runs=${1:-3}
 threads=${2:-1}
-set -a; . .oracle/env 2>/dev/null || . /work/main/.oracle/env; set +a
+[ -f .oracle/env ] || scripts/oracle.sh > /dev/null
+set -a; . .oracle/env; set +a
 export FENESTRA_NO_PROGRESS=1
 ours=$(realpath "${CARGO_TARGET_DIR:-target}/testopt/rtrace")
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT

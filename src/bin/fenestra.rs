@@ -19,15 +19,7 @@ fn main() -> ExitCode {
         );
         return ExitCode::from(1);
     };
-    fenestra_cli::set_prog(&args[0]);
-    match fenestra_cli::expand::expand_args(args).and_then(run) {
-        Ok(code) => code,
-        Err(e) => {
-            if let Some(fenestra_cli::Exit(code)) = e.downcast_ref::<fenestra_cli::Exit>() {
-                return ExitCode::from(*code);
-            }
-            eprintln!("{}: fatal - {:#}", fenestra_cli::prog(), e);
-            ExitCode::from(1)
-        }
-    }
+    // the same entry as the single binaries: messages, exit codes, a closed pipe, deep
+    // stacks and interrupted outputs alike
+    fenestra_cli::main_with_args(args, *run)
 }

@@ -51,6 +51,15 @@ pub fn main_with(run: fn(Vec<String>) -> anyhow::Result<ExitCode>) -> ExitCode {
     let raw: Vec<String> = std::env::args_os()
         .map(|a| a.to_string_lossy().into_owned())
         .collect();
+    main_with_args(raw, run)
+}
+
+/// [`main_with`] for given arguments (the first is the program name): the multicall
+/// `fenestra TOOL …` runs its tools through this, with the same messages and exit codes.
+pub fn main_with_args(
+    raw: Vec<String>,
+    run: fn(Vec<String>) -> anyhow::Result<ExitCode>,
+) -> ExitCode {
     if let Some(p) = raw.first() {
         set_prog(p);
     }
