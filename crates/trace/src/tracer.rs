@@ -29,6 +29,9 @@ mod shade_bsdf;
 mod shade_glass;
 mod shade_light;
 mod shade_normal;
+
+use direct::{Aim, Lit};
+use shade_normal::NormalLobes;
 mod threshold;
 
 use ambient::frame;
@@ -103,6 +106,53 @@ struct Ray {
 }
 
 /// A map from scene index to value stored densely (indexing is a bounds check, not a hash).
+/// Where a ray meets a surface: the shape, the point, the surface normal as stored (not
+/// turned toward the ray), `rod` = −ray direction · normal, and the distance travelled.
+#[derive(Debug, Clone, Copy)]
+struct Surf {
+    shape: usize,
+    p: DVec3,
+    n: DVec3,
+    rod: f64,
+    t: f64,
+}
+
+impl Origin {
+    /// A ray's start at `p` (leaving flat surface `skip`), at no distance.
+    fn at(p: DVec3, skip: Option<usize>) -> Origin {
+        Origin { p, skip, dist: 0.0 }
+    }
+}
+
+impl Surf {
+    /// The same point seen from the surface's other side.
+    fn flipped(self) -> Surf {
+        Surf {
+            n: -self.n,
+            rod: -self.rod,
+            ..self
+        }
+    }
+}
+
+/// Where a ray that a surface spawns starts: the point, the flat surface it leaves (not
+/// hit again), and the distance its parent travelled to get there.
+#[derive(Debug, Clone, Copy)]
+struct Origin {
+    p: DVec3,
+    skip: Option<usize>,
+    dist: f64,
+}
+
+/// What a tracked surface or source reports to rcontrib: the point met, its normal and
+/// the distance along the ray.
+#[derive(Debug, Clone, Copy)]
+struct Met {
+    point: DVec3,
+    normal: DVec3,
+    dist: f64,
+}
+
 struct Dense<T>(Vec<Option<T>>);
 
 impl<T> Default for Dense<T> {
@@ -279,17 +329,8 @@ impl Tracer {
         }
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn child(
-        &self,
-        r: &Ray,
-        org: DVec3,
-        dir: DVec3,
-        flag: u8,
-        rcoef: DVec3,
-        skip: Option<usize>,
-        dist: f64,
-    ) -> Ray {
+    fn child(&self, r: &Ray, from: Origin, dir: DVec3, flag: u8, rcoef: DVec3) -> Ray {
+        let Origin { p: org, skip, dist } = from;
         // A transmitted ray carries on what is left of a limited length (rcontrib -ld+:
         // Radiance limits the ray through glass, not the reflected one); shadow rays set
         // their own length.
@@ -314,18 +355,12 @@ impl Tracer {
         }
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn report(
-        &self,
-        cx: &mut Ctx,
-        r: &Ray,
-        prim: usize,
-        rcol: DVec3,
-        hit: DVec3,
-        normal: DVec3,
-        dist: f64,
-        zeroed: bool,
-    ) {
+    fn report(&self, cx: &mut Ctx, r: &Ray, prim: usize, rcol: DVec3, met: Met, zeroed: bool) {
+        let Met {
+            point: hit,
+            normal,
+            dist,
+        } = met;
         let Some(sink) = cx.sink.as_mut() else { return };
         let Some(m) = self.modifier_of[prim] else {
             return;
@@ -369,17 +404,8 @@ impl Tracer {
                         return DVec3::ZERO;
                     }
                     let d = &self.distant[k];
-                    let (val, zeroed) = self.shade_light(
-                        r,
-                        d.mat,
-                        d.prim,
-                        1.0,
-                        f64::INFINITY,
-                        DVec3::ZERO,
-                        None,
-                        cx,
-                    );
-                    self.report(cx, r, d.prim, val, r.org, -r.dir, 1e10, zeroed);
+                    let (val, zeroed) = self.shade_light(r, d.mat, d.prim, None, cx);
+                    self.report(cx, r, d.prim, val, Self::distant_met(r), zeroed);
                     return val;
                 }
             }
@@ -398,28 +424,48 @@ impl Tracer {
                 };
                 let Some(k) = k else { return DVec3::ZERO };
                 let d = &self.distant[k];
-                let (val, zeroed) =
-                    self.shade_light(r, d.mat, d.prim, 1.0, f64::INFINITY, DVec3::ZERO, None, cx);
-                self.report(cx, r, d.prim, val, r.org, -r.dir, 1e10, zeroed);
+                let (val, zeroed) = self.shade_light(r, d.mat, d.prim, None, cx);
+                self.report(cx, r, d.prim, val, Self::distant_met(r), zeroed);
                 val
             }
             Some(h) => {
                 let p = r.org + r.dir * h.t;
                 let n = self.accel.shapes[h.shape].normal(p);
                 let m = self.surf_mat[h.shape];
+                let met = Met {
+                    point: p,
+                    normal: n,
+                    dist: h.t,
+                };
                 if r.clip.contains(m) {
                     // inside antimatter: this surface is not there (rcontrib still hears of
                     // it, with what came through, as from Radiance)
                     let mut c = r.clone();
                     c.clip.cross(m, r.dir.dot(n) < 0.0);
                     let val = self.pass(c, h.shape, p, h.t, cx);
-                    self.report(cx, r, self.surf_prim[h.shape], val, p, n, h.t, false);
+                    self.report(cx, r, self.surf_prim[h.shape], val, met, false);
                     return val;
                 }
-                let (val, zeroed) = self.shade(r, m, h.shape, p, n, h.t, cx);
-                self.report(cx, r, self.surf_prim[h.shape], val, p, n, h.t, zeroed);
+                let s = Surf {
+                    shape: h.shape,
+                    p,
+                    n,
+                    rod: -r.dir.dot(n),
+                    t: h.t,
+                };
+                let (val, zeroed) = self.shade(r, m, &s, cx);
+                self.report(cx, r, self.surf_prim[h.shape], val, met, zeroed);
                 val
             }
+        }
+    }
+
+    /// What a distant source reports: the ray's origin, facing it, at 1e10 (Radiance's).
+    fn distant_met(r: &Ray) -> Met {
+        Met {
+            point: r.org,
+            normal: -r.dir,
+            dist: 1e10,
         }
     }
 
@@ -443,18 +489,14 @@ impl Tracer {
         self.trace(&c, cx)
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn shade(
-        &self,
-        r: &Ray,
-        m: usize,
-        shape: usize,
-        p: DVec3,
-        n: DVec3,
-        t: f64,
-        cx: &mut Ctx,
-    ) -> (DVec3, bool) {
-        let rod = -r.dir.dot(n);
+    fn shade(&self, r: &Ray, m: usize, s: &Surf, cx: &mut Ctx) -> (DVec3, bool) {
+        let Surf {
+            shape,
+            p,
+            n,
+            rod,
+            t,
+        } = *s;
         if r.flags & IRRAD != 0 && r.flags & !(IRRAD | TRANS) == 0 {
             // -i: emitters and antimatter act as usual (an illum passes the ray on to its
             // alternate material, antimatter shades with its first modifier where a ray
@@ -471,33 +513,24 @@ impl Tracer {
             }
         }
         match &self.mats[&m] {
-            Material::Light { .. } => {
-                self.shade_light(r, m, self.surf_prim[shape], rod, t, p, Some(shape), cx)
+            Material::Light { .. } => self.shade_light(r, m, self.surf_prim[shape], Some(s), cx),
+            Material::Glass { tn, n: idx } => (self.shade_glass(r, *tn, *idx, s, cx), false),
+            Material::Dielectric { tn, n: idx } => {
+                (self.shade_dielectric(r, *tn, *idx, s, cx), false)
             }
-            Material::Glass { tn, n: idx } => (
-                self.shade_glass(r, *tn, *idx, shape, p, n, rod, t, cx),
-                false,
-            ),
-            Material::Dielectric { tn, n: idx } => (
-                self.shade_dielectric(r, *tn, *idx, shape, p, n, rod, t, cx),
-                false,
-            ),
-            Material::Bsdf(b) => (self.shade_bsdf(r, b, shape, p, n, t, cx), false),
+            Material::Bsdf(b) => (self.shade_bsdf(r, b, s, cx), false),
             // Reported to rcontrib with the value of the ray that met it, as by Radiance.
             Material::Antimatter { mods, first } => {
-                (self.antimatter(r, mods, *first, shape, p, n, t, cx), false)
+                (self.antimatter(r, mods, *first, s, cx), false)
             }
             Material::Mirror { color } => {
                 if r.flags & SHADOW != 0 {
-                    return (self.relay(r, shape, p, n, rod, t, *color, cx), false);
+                    return (self.relay(r, s, *color, cx), false);
                 }
                 let nrm = if rod < 0.0 { -n } else { n };
                 let pdot = rod.abs();
                 let dir = (r.dir + nrm * (2.0 * pdot)).normalize();
-                (
-                    self.spawn(r, p, dir, REFLECTED, *color, shape, t, cx),
-                    false,
-                )
+                (self.spawn(r, s, dir, REFLECTED, *color, cx), false)
             }
             Material::Normal {
                 color: c0,
@@ -518,16 +551,14 @@ impl Tracer {
                             dist: t,
                         },
                     ),
-                    *spec,
-                    *rough,
-                    *trans,
-                    *tspec,
-                    *metal,
-                    shape,
-                    p,
-                    n,
-                    rod,
-                    t,
+                    &NormalLobes {
+                        spec: *spec,
+                        rough: *rough,
+                        trans: *trans,
+                        tspec: *tspec,
+                        metal: *metal,
+                    },
+                    s,
                     cx,
                 ),
                 false,
@@ -538,23 +569,19 @@ impl Tracer {
     /// A ray reaching an antimatter surface: entering, it goes on blind to `mods`; leaving
     /// inside a volume of `first`, the surface is shaded with `first` facing the ray (the
     /// ray's clip set kept for what that spawns); otherwise it goes on seeing `mods` again.
-    #[allow(clippy::too_many_arguments)]
     fn antimatter(
         &self,
         r: &Ray,
         mods: &[usize],
         first: Option<usize>,
-        shape: usize,
-        p: DVec3,
-        n: DVec3,
-        t: f64,
+        s: &Surf,
         cx: &mut Ctx,
     ) -> DVec3 {
-        let entering = r.dir.dot(n) < 0.0;
+        let entering = r.dir.dot(s.n) < 0.0;
         if !entering {
             if let Some(f) = first {
                 if r.clip.inside(f) {
-                    return self.shade(r, f, shape, p, -n, t, cx).0;
+                    return self.shade(r, f, &s.flipped(), cx).0;
                 }
             }
         }
@@ -567,24 +594,23 @@ impl Tracer {
                 c.clip.remove(m);
             }
         }
-        self.pass(c, shape, p, t, cx)
+        self.pass(c, s.shape, s.p, s.t, cx)
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn spawn(
-        &self,
-        r: &Ray,
-        p: DVec3,
-        dir: DVec3,
-        flag: u8,
-        rcoef: DVec3,
-        shape: usize,
-        t: f64,
-        cx: &mut Ctx,
-    ) -> DVec3 {
+    /// Where rays spawned at `s` start: its point, skipping it if flat.
+    fn origin(&self, s: &Surf) -> Origin {
+        Origin {
+            p: s.p,
+            skip: self.accel.shapes[s.shape].is_flat().then_some(s.shape),
+            dist: s.t,
+        }
+    }
+
+    /// Traces a ray spawned at `s` along `dir` with coefficient `rcoef` (Russian roulette
+    /// and `-lw` applied) and returns its weighted value.
+    fn spawn(&self, r: &Ray, s: &Surf, dir: DVec3, flag: u8, rcoef: DVec3, cx: &mut Ctx) -> DVec3 {
         let mut rc = rcoef;
-        let skip = self.accel.shapes[shape].is_flat().then_some(shape);
-        let mut c = self.child(r, p, dir, flag, rc, skip, t);
+        let mut c = self.child(r, self.origin(s), dir, flag, rc);
         if !self.admit(&mut c, &mut rc, cx) {
             return DVec3::ZERO;
         }

@@ -35,7 +35,7 @@ impl Tracer {
         let skip = shape.filter(|&s| self.accel.shapes[s].is_flat());
         let shoot = |dir: DVec3, acoef: DVec3, cx: &mut Ctx| {
             let mut rc = acoef;
-            let mut c = self.child(r, p, dir, AMBIENT, rc, skip, 0.0);
+            let mut c = self.child(r, Origin::at(p, skip), dir, AMBIENT, rc);
             c.amb = r.amb + 1;
             if !self.admit(&mut c, &mut rc, cx) {
                 return DVec3::ZERO;

@@ -3,19 +3,44 @@
 
 use super::*;
 
+/// A surface point lit by sources: the point, the normal of the side lit, and the
+/// surface, if any (the `-I` point is on none).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Lit {
+    pub(super) p: DVec3,
+    pub(super) n: DVec3,
+    pub(super) shape: Option<usize>,
+}
+
+impl Lit {
+    /// A point on surface `shape`.
+    pub(super) fn on(p: DVec3, n: DVec3, shape: usize) -> Lit {
+        Lit {
+            p,
+            n,
+            shape: Some(shape),
+        }
+    }
+}
+
+/// Where a shadow ray goes: its unit direction, its length and the source it is aimed at.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Aim {
+    pub(super) l: DVec3,
+    pub(super) tmax: f64,
+    pub(super) si: usize,
+}
+
 impl Tracer {
     /// Direct lighting at `p` (normal `nrm`): `bsdf(l, omega, ldot)` gives the coefficient
     /// of a source sample; a shadow ray fetches the source's radiance. With source
     /// thresholding (`-dt > 0`, a [`DirectState`] in `cx`), only the brightest samples are
     /// shadow-tested ([`Self::direct_threshold`]); `prior` is what the surface already
     /// returns from its other components (Radiance computes direct light last).
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn direct(
         &self,
         r: &Ray,
-        p: DVec3,
-        nrm: DVec3,
-        shape: Option<usize>,
+        lit: Lit,
         prior: DVec3,
         cx: &mut Ctx,
         bsdf: impl Fn(DVec3, f64, f64) -> DVec3,
@@ -25,19 +50,22 @@ impl Tracer {
             return val;
         }
         if cx.ds.is_some() {
-            return self.direct_threshold(r, p, nrm, shape, prior, cx, bsdf);
+            return self.direct_threshold(r, lit, prior, cx, bsdf);
         }
+        let Lit { p, n: nrm, shape } = lit;
         let skip = shape.filter(|&s| self.accel.shapes[s].is_flat());
         for si in 0..self.sources.len() {
             self.each_sample(si, p, shape, r.weight, cx, |cx, s| {
                 let ldot = s.l.dot(nrm);
+                let aim = Aim {
+                    l: s.l,
+                    tmax: s.tmax,
+                    si,
+                };
                 self.shadow(
                     r,
-                    p,
-                    s.l,
-                    s.tmax,
-                    si,
-                    skip,
+                    Origin::at(p, skip),
+                    aim,
                     bsdf(s.l, s.omega, ldot),
                     &mut val,
                     cx,
@@ -208,18 +236,14 @@ impl Tracer {
     /// A shadow ray meeting a mirror: if it is aimed at that mirror's image of a distant
     /// source, it continues, reflected, toward the real source (weighted by the mirror's
     /// colour); any other shadow ray is stopped.
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn relay(
-        &self,
-        r: &Ray,
-        shape: usize,
-        p: DVec3,
-        n: DVec3,
-        rod: f64,
-        t: f64,
-        color: DVec3,
-        cx: &mut Ctx,
-    ) -> DVec3 {
+    pub(super) fn relay(&self, r: &Ray, s: &Surf, color: DVec3, cx: &mut Ctx) -> DVec3 {
+        let Surf {
+            shape,
+            p,
+            n,
+            rod,
+            t,
+        } = *s;
         let Some(SourceGeom::Virtual { base, mirror, .. }) = r.src.map(|s| self.sources[s].geom)
         else {
             return DVec3::ZERO;
@@ -235,21 +259,22 @@ impl Tracer {
         if self.distant[k].dir.dot(nrm) <= 0.0 {
             return DVec3::ZERO;
         }
-        let mut c = self.child(r, p, dir, 0, color, Some(shape), t);
+        let from = Origin {
+            p,
+            skip: Some(shape),
+            dist: t,
+        };
+        let mut c = self.child(r, from, dir, 0, color);
         c.weight = r.weight;
         c.src = Some(base);
         color * self.trace(&c, cx)
     }
 
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn shadow(
         &self,
         r: &Ray,
-        p: DVec3,
-        l: DVec3,
-        tmax: f64,
-        si: usize,
-        skip: Option<usize>,
+        from: Origin,
+        aim: Aim,
         coef: DVec3,
         val: &mut DVec3,
         cx: &mut Ctx,
@@ -259,29 +284,18 @@ impl Tracer {
         if maxc(coef) <= 0.0 {
             return;
         }
-        let c = self.shadow_ray(r, p, l, tmax, si, skip, coef);
+        let c = self.shadow_ray(r, from, aim, coef);
         *val += coef * self.trace(&c, cx);
     }
 
-    /// The shadow ray from `p` (on surface `skip`, if flat) along `l` toward source `si`,
-    /// `tmax` long, with coefficient `coef`. Radiance starts shadow rays without a
-    /// coefficient: they keep the parent's weight and are never subject to Russian
-    /// roulette.
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn shadow_ray(
-        &self,
-        r: &Ray,
-        p: DVec3,
-        l: DVec3,
-        tmax: f64,
-        si: usize,
-        skip: Option<usize>,
-        coef: DVec3,
-    ) -> Ray {
-        let mut c = self.child(r, p, l, SHADOW, coef, skip, 0.0);
+    /// The shadow ray from `from` along `aim` toward its source, with coefficient `coef`.
+    /// Radiance starts shadow rays without a coefficient: they keep the parent's weight
+    /// and are never subject to Russian roulette.
+    pub(super) fn shadow_ray(&self, r: &Ray, from: Origin, aim: Aim, coef: DVec3) -> Ray {
+        let mut c = self.child(r, from, aim.l, SHADOW, coef);
         c.weight = r.weight;
-        c.src = Some(si);
-        c.tmax = tmax;
+        c.src = Some(aim.si);
+        c.tmax = aim.tmax;
         c
     }
 

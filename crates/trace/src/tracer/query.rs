@@ -93,18 +93,15 @@ impl Tracer {
         tracked: &[bool],
         sink: &mut impl FnMut(Contribution),
     ) -> [f64; 3] {
-        self.contributions_flagged(ray_index, org, dir, len, 0, tracked, sink)
+        self.contributions_flagged(ray_index, (org, dir, len), 0, tracked, sink)
     }
 
-    /// The primary ray of rcontrib's normal (`flags` 0) and `-i` (`IRRAD`) modes, ending
-    /// after `len`, traced with `sink` receiving the tracked contributions.
-    #[allow(clippy::too_many_arguments)]
+    /// The primary ray (origin, direction, length) of rcontrib's normal (`flags` 0) and
+    /// `-i` (`IRRAD`) modes, traced with `sink` receiving the tracked contributions.
     pub(super) fn contributions_flagged(
         &self,
         ray_index: u64,
-        org: DVec3,
-        dir: DVec3,
-        len: f64,
+        (org, dir, len): (DVec3, DVec3, f64),
         flags: u8,
         tracked: &[bool],
         sink: &mut impl FnMut(Contribution),
@@ -289,6 +286,6 @@ impl Tracer {
         tracked: &[bool],
         sink: &mut impl FnMut(Contribution),
     ) -> [f64; 3] {
-        self.contributions_flagged(ray_index, org, dir, len, IRRAD, tracked, sink)
+        self.contributions_flagged(ray_index, (org, dir, len), IRRAD, tracked, sink)
     }
 }

@@ -4,17 +4,14 @@
 use super::*;
 
 impl Tracer {
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn shade_bsdf(
         &self,
         r: &Ray,
         b: &crate::bsdf_mat::BsdfMat,
-        shape: usize,
-        p: DVec3,
-        n: DVec3,
-        t: f64,
+        s: &Surf,
         cx: &mut Ctx,
     ) -> DVec3 {
+        let (shape, p, n) = (s.shape, s.p, s.n);
         if r.flags & SHADOW != 0 {
             return DVec3::ZERO;
         }
@@ -49,14 +46,14 @@ impl Tracer {
         let mut val = if last {
             DVec3::ZERO
         } else {
-            self.direct(r, p, side, Some(shape), DVec3::ZERO, cx, lobe)
+            self.direct(r, Lit::on(p, side, shape), DVec3::ZERO, cx, lobe)
         };
         for (comp, flag) in [(refl, REFLECTED), (trans, TRANS)] {
             let Some(c) = comp else { continue };
             let (u, u0, u1) = (cx.rng.next_f64(), cx.rng.next_f64(), cx.rng.next_f64());
             if let Some((d, h)) = c.sample(v, u, u0, u1) {
                 let dir = (x * d.x + y * d.y + z * d.z).normalize();
-                val += self.spawn(r, p, dir, SPECULAR | flag, DVec3::splat(h), shape, t, cx);
+                val += self.spawn(r, s, dir, SPECULAR | flag, DVec3::splat(h), cx);
             }
         }
         if maxc(rd) > FTINY {
@@ -66,7 +63,7 @@ impl Tracer {
             val += self.ambient(r, p, -side, td, Some(shape), cx);
         }
         if last {
-            val += self.direct(r, p, side, Some(shape), val, cx, lobe);
+            val += self.direct(r, Lit::on(p, side, shape), val, cx, lobe);
         }
         val
     }

@@ -3,19 +3,15 @@
 use super::*;
 
 impl Tracer {
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn shade_dielectric(
         &self,
         r: &Ray,
         tn: DVec3,
         idx: f64,
-        shape: usize,
-        p: DVec3,
-        n: DVec3,
-        rod: f64,
-        t: f64,
+        s: &Surf,
         cx: &mut Ctx,
     ) -> DVec3 {
+        let (n, rod, t) = (s.n, s.rod, s.t);
         // entering from the front (outside) or leaving from inside
         let entering = rod > 0.0;
         let nrm = if entering { n } else { -n };
@@ -37,7 +33,7 @@ impl Tracer {
             if r.flags & SHADOW != 0 {
                 return DVec3::ZERO;
             }
-            return atten * self.spawn(r, p, refl_dir, REFLECTED, DVec3::ONE, shape, t, cx);
+            return atten * self.spawn(r, s, refl_dir, REFLECTED, DVec3::ONE, cx);
         }
         let cos_t = (1.0 - sin2_t).sqrt();
         let rs = ((eta * cos_i - cos_t) / (eta * cos_i + cos_t)).powi(2);
@@ -48,28 +44,24 @@ impl Tracer {
         if r.flags & SHADOW != 0 {
             // a bent shadow ray no longer points at its source, except at index 1
             if (idx - 1.0).abs() < 1e-6 {
-                val += self.spawn(r, p, r.dir, TRANS, DVec3::splat(1.0 - fr), shape, t, cx);
+                val += self.spawn(r, s, r.dir, TRANS, DVec3::splat(1.0 - fr), cx);
             }
             return atten * val;
         }
-        val += self.spawn(r, p, tdir, TRANS, DVec3::splat(1.0 - fr), shape, t, cx);
-        val += self.spawn(r, p, refl_dir, REFLECTED, DVec3::splat(fr), shape, t, cx);
+        val += self.spawn(r, s, tdir, TRANS, DVec3::splat(1.0 - fr), cx);
+        val += self.spawn(r, s, refl_dir, REFLECTED, DVec3::splat(fr), cx);
         atten * val
     }
 
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn shade_glass(
         &self,
         r: &Ray,
         tn: DVec3,
         idx: f64,
-        shape: usize,
-        p: DVec3,
-        n: DVec3,
-        rod: f64,
-        t: f64,
+        s: &Surf,
         cx: &mut Ctx,
     ) -> DVec3 {
+        let (n, rod) = (s.n, s.rod);
         let pdot = rod.abs().max(1e-3);
         let nrm = if rod < 0.0 { -n } else { n };
         let cos2 = ((1.0 - 1.0 / (idx * idx)) + pdot * pdot / (idx * idx)).sqrt();
@@ -87,11 +79,11 @@ impl Tracer {
         }
         let mut val = DVec3::ZERO;
         if maxc(trans) > FTINY {
-            val += self.spawn(r, p, r.dir, TRANS, trans, shape, t, cx);
+            val += self.spawn(r, s, r.dir, TRANS, trans, cx);
         }
         if r.flags & SHADOW == 0 && maxc(refl) > FTINY {
             let dir = (r.dir + nrm * (2.0 * pdot)).normalize();
-            val += self.spawn(r, p, dir, REFLECTED, refl, shape, t, cx);
+            val += self.spawn(r, s, dir, REFLECTED, refl, cx);
         }
         val
     }

@@ -3,18 +3,17 @@
 use super::*;
 
 impl Tracer {
-    #[allow(clippy::too_many_arguments)]
+    /// An emitter `m` (object `prim`) met by `r` at `at` (`None`: a distant source).
     pub(super) fn shade_light(
         &self,
         r: &Ray,
         m: usize,
         prim: usize,
-        rod: f64,
-        t: f64,
-        p: DVec3,
-        shape: Option<usize>,
+        at: Option<&Surf>,
         cx: &mut Ctx,
     ) -> (DVec3, bool) {
+        let (rod, t, p) = at.map_or((1.0, f64::INFINITY, DVec3::ZERO), |s| (s.rod, s.t, s.p));
+        let shape = at.map(|s| s.shape);
         let Material::Light { color, kind } = &self.mats[&m] else {
             return (DVec3::ZERO, false);
         };
@@ -54,13 +53,10 @@ impl Tracer {
             // ray, or a shadow ray toward another source such as the sun through the
             // window it stands in) meets its alternate material.
             if r.src.is_none() || !own_source {
-                if let Some(shape) = shape {
+                if let Some(s) = at {
                     return match alt {
-                        Some(a) => {
-                            let n = self.accel.shapes[shape].normal(p);
-                            self.shade(r, *a, shape, p, n, t, cx)
-                        }
-                        None => (self.pass(r.clone(), shape, p, t, cx), false),
+                        Some(a) => self.shade(r, *a, s, cx),
+                        None => (self.pass(r.clone(), s.shape, s.p, s.t, cx), false),
                     };
                 }
             }

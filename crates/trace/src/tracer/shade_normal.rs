@@ -3,6 +3,16 @@
 
 use super::*;
 
+/// The lobes of a plastic, metal or trans material (its colour comes patterned).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct NormalLobes {
+    pub(super) spec: f64,
+    pub(super) rough: f64,
+    pub(super) trans: f64,
+    pub(super) tspec: f64,
+    pub(super) metal: bool,
+}
+
 impl Tracer {
     /// Irradiance at `p` on a surface facing unit `n` (Radiance's irradiance hack: a
     /// Lambertian of reflectance pi there, patterns ignored), reached by ray `r` (its clip
@@ -28,30 +38,29 @@ impl Tracer {
             // thresholding: direct light last, as Radiance (its threshold is relative
             // to what the surface already returns)
             let amb = self.ambient(r, p, n, rho, shape, cx);
-            return amb + self.direct(r, p, n, shape, amb, cx, lamb);
+            return amb + self.direct(r, Lit { p, n, shape }, amb, cx, lamb);
         }
-        let mut val = self.direct(r, p, n, shape, DVec3::ZERO, cx, lamb);
+        let mut val = self.direct(r, Lit { p, n, shape }, DVec3::ZERO, cx, lamb);
         val += self.ambient(r, p, n, rho, shape, cx);
         val
     }
 
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn shade_normal(
         &self,
         r: &Ray,
         color: DVec3,
-        spec: f64,
-        rough: f64,
-        trans: f64,
-        tspec_frac: f64,
-        metal: bool,
-        shape: usize,
-        p: DVec3,
-        n: DVec3,
-        rod: f64,
-        t: f64,
+        lobes: &NormalLobes,
+        s: &Surf,
         cx: &mut Ctx,
     ) -> DVec3 {
+        let NormalLobes {
+            spec,
+            rough,
+            trans,
+            tspec: tspec_frac,
+            metal,
+        } = *lobes;
+        let (shape, p, n, rod) = (s.shape, s.p, s.n, s.rod);
         let nrm = if rod < 0.0 { -n } else { n };
         let pdot = rod.abs().max(1e-3);
         let alpha2 = rough * rough;
@@ -78,7 +87,7 @@ impl Tracer {
         };
         if r.flags & SHADOW != 0 {
             if tspec > FTINY && pure {
-                return self.spawn(r, p, r.dir, TRANS, color * tspec, shape, t, cx);
+                return self.spawn(r, s, r.dir, TRANS, color * tspec, cx);
             }
             return DVec3::ZERO;
         }
@@ -117,12 +126,12 @@ impl Tracer {
         let mut val = if last {
             DVec3::ZERO
         } else {
-            self.direct(r, p, nrm, Some(shape), DVec3::ZERO, cx, lobe)
+            self.direct(r, Lit::on(p, nrm, shape), DVec3::ZERO, cx, lobe)
         };
         if self.effects.specular {
             if rspec > FTINY && pure {
                 let dir = (d + nrm * (2.0 * pdot)).normalize();
-                val += self.spawn(r, p, dir, REFLECTED, scolor, shape, t, cx);
+                val += self.spawn(r, s, dir, REFLECTED, scolor, cx);
             } else if rspec > FTINY && self.opts.ss > 0.0 && rspec > self.opts.st {
                 // one Ward-lobe sample (isotropic)
                 let (u, v) = (cx.rng.next_f64(), cx.rng.next_f64());
@@ -134,20 +143,11 @@ impl Tracer {
                 let h = a * (st * phi.cos()) + b * (st * phi.sin()) + nrm * ct;
                 let dir = d - h * (2.0 * d.dot(h));
                 if dir.dot(nrm) > 0.0 {
-                    val += self.spawn(
-                        r,
-                        p,
-                        dir.normalize(),
-                        SPECULAR | REFLECTED,
-                        scolor,
-                        shape,
-                        t,
-                        cx,
-                    );
+                    val += self.spawn(r, s, dir.normalize(), SPECULAR | REFLECTED, scolor, cx);
                 }
             }
             if tspec > FTINY && pure {
-                val += self.spawn(r, p, d, TRANS, color * tspec, shape, t, cx);
+                val += self.spawn(r, s, d, TRANS, color * tspec, cx);
             }
         }
         if rdiff > FTINY {
@@ -157,7 +157,7 @@ impl Tracer {
             val += self.ambient(r, p, -nrm, color * tdiff, Some(shape), cx);
         }
         if last {
-            val += self.direct(r, p, nrm, Some(shape), val, cx, lobe);
+            val += self.direct(r, Lit::on(p, nrm, shape), val, cx, lobe);
         }
         val
     }

@@ -583,8 +583,7 @@ impl Tracer {
         match s.geom {
             SourceGeom::Distant(k) => {
                 let d = &self.distant[k];
-                self.shade_light(c, d.mat, d.prim, 1.0, f64::INFINITY, DVec3::ZERO, None, cx)
-                    .0
+                self.shade_light(c, d.mat, d.prim, None, cx).0
             }
             SourceGeom::Local(sh) => {
                 let shp = &self.accel.shapes[sh];
@@ -605,9 +604,15 @@ impl Tracer {
                 match shp.intersect(c.org, c.dir, tmin, f64::INFINITY) {
                     Some(t) => {
                         let q = c.org + c.dir * t;
-                        let rod = -c.dir.dot(shp.normal(q));
-                        self.shade_light(c, s.mat, s.prim, rod, t, q, Some(sh), cx)
-                            .0
+                        let n = shp.normal(q);
+                        let at = Surf {
+                            shape: sh,
+                            p: q,
+                            n,
+                            rod: -c.dir.dot(n),
+                            t,
+                        };
+                        self.shade_light(c, s.mat, s.prim, Some(&at), cx).0
                     }
                     None => DVec3::ZERO,
                 }
@@ -634,16 +639,7 @@ impl Tracer {
                 rc.org = q;
                 rc.dir = (c.dir + nrm * (2.0 * rod.abs())).normalize();
                 rc.src = Some(base);
-                let v = self.shade_light(
-                    &rc,
-                    d.mat,
-                    d.prim,
-                    1.0,
-                    f64::INFINITY,
-                    DVec3::ZERO,
-                    None,
-                    cx,
-                );
+                let v = self.shade_light(&rc, d.mat, d.prim, None, cx);
                 *color * v.0
             }
         }
@@ -654,13 +650,12 @@ impl Tracer {
     pub(super) fn direct_threshold(
         &self,
         r: &Ray,
-        p: DVec3,
-        nrm: DVec3,
-        shape: Option<usize>,
+        lit: Lit,
         prior: DVec3,
         cx: &mut Ctx,
         bsdf: impl Fn(DVec3, f64, f64) -> DVec3,
     ) -> DVec3 {
+        let Lit { p, n: nrm, shape } = lit;
         let skip = shape.filter(|&s| self.accel.shapes[s].is_flat());
         let Some(st) = cx.ds.as_deref_mut() else {
             return DVec3::ZERO;
@@ -686,7 +681,12 @@ impl Tracer {
                 if maxc(coef) <= 0.0 {
                     return;
                 }
-                let c = self.shadow_ray(r, p, s.l, s.tmax, si, skip, DVec3::ONE);
+                let aim = Aim {
+                    l: s.l,
+                    tmax: s.tmax,
+                    si,
+                };
+                let c = self.shadow_ray(r, Origin::at(p, skip), aim, DVec3::ONE);
                 let val = coef * self.potential(&c, si, cx);
                 let brt = bright(val) as f32;
                 if brt > 0.0 {
@@ -735,7 +735,12 @@ impl Tracer {
             if let Some(st) = cx.ds.as_deref_mut() {
                 st.ntests[cd.si] += 1;
             }
-            let c = self.shadow_ray(r, p, cd.l, cd.tmax, cd.si, skip, cd.coef);
+            let aim = Aim {
+                l: cd.l,
+                tmax: cd.tmax,
+                si: cd.si,
+            };
+            let c = self.shadow_ray(r, Origin::at(p, skip), aim, cd.coef);
             let v = self.trace(&c, cx);
             let Some(st) = cx.ds.as_deref_mut() else {
                 break;
