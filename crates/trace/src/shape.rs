@@ -81,7 +81,7 @@ impl Shape {
                 r0,
                 r1,
                 ..
-            } => cone_hit(*p0, *axis, *len, *r0, *r1, org, dir, tmin, tmax),
+            } => cone_hit((*p0, *axis, *len, *r0, *r1), org, dir, (tmin, tmax)),
             Shape::Ring { c, n, r0, r1 } => {
                 let dn = dir.dot(*n);
                 if dn.abs() < PARALLEL_EPS {
@@ -181,17 +181,13 @@ fn disk_bounds(c: DVec3, n: DVec3, r: f64) -> (DVec3, DVec3) {
     (c - e, c + e)
 }
 
-#[allow(clippy::too_many_arguments)]
+/// The nearest hit within (tmin, tmax) of the cone (base `p0`, unit `axis`, length,
+/// radii at both ends).
 fn cone_hit(
-    p0: DVec3,
-    axis: DVec3,
-    len: f64,
-    r0: f64,
-    r1: f64,
+    (p0, axis, len, r0, r1): (DVec3, DVec3, f64, f64, f64),
     org: DVec3,
     dir: DVec3,
-    tmin: f64,
-    tmax: f64,
+    (tmin, tmax): (f64, f64),
 ) -> Option<f64> {
     // radius along axis: r(h) = r0 + k h, k = (r1-r0)/len; surface |v_perp|^2 = r(h)^2
     let k = (r1 - r0) / len;

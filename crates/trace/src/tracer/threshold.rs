@@ -646,7 +646,6 @@ impl Tracer {
     }
 
     /// [`Tracer::direct`] with thresholding (see the module documentation).
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn direct_threshold(
         &self,
         r: &Ray,
