@@ -15,13 +15,7 @@ pub mod sampled;
 use crate::klems::KlemsBasis;
 use crate::model::{Bsdf, Direction, KlemsMatrix, Wavelength};
 
-/// Radiance's threshold for splitting a matrix minimum off as a Lambertian part (sr⁻¹).
-pub const LAMBERTIAN_MIN: f64 = 0.01 / std::f64::consts::PI;
-
-/// For tensor trees Radiance splits the minimum off only below this value (sr⁻¹): π·min must
-/// stay under 1.5 (found with the oracle on 2×2×2×2 trees: minimum 0.4774 split off as 150.0%,
-/// 0.4775 and above nothing; Klems matrices have no such limit: 154.5% split off).
-pub const TREE_LAMBERTIAN_MAX: f64 = 1.5 / std::f64::consts::PI;
+pub use crate::radiance::{radiance_min, LAMBERTIAN_MIN, TREE_LAMBERTIAN_MAX};
 
 /// Summary of one component (one XML direction).
 #[derive(Debug, Clone, PartialEq)]
@@ -41,21 +35,6 @@ pub struct ComponentCheck {
     pub diffuse_total: f64,
     /// Directional-hemispherical total per incident patch.
     pub totals: Vec<f64>,
-}
-
-/// The minimum Radiance splits off a grey matrix: the smallest single-precision value times
-/// Radiance's position factor `1 + 6e-4·(d − ½)` (d the fraction of
-/// `2·n_in/(i + 0.22545) + 4·n_out/(o + 0.70281)`), so up to 3e-4 below the plain minimum (found
-/// with the oracle: a constant matrix of π·value 12.351% prints 12.3).
-pub fn radiance_min(m: &KlemsMatrix) -> f64 {
-    let (ni, no) = (m.incident.len(), m.outgoing.len());
-    let mut min = 1e10f32;
-    for i in 0..ni {
-        for o in 0..no {
-            min = min.min(crate::radiance::jittered(m, o, i));
-        }
-    }
-    f64::from(min)
 }
 
 /// Reciprocity error statistics (fractions).

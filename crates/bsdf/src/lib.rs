@@ -8,6 +8,7 @@ pub mod model;
 pub mod radiance;
 pub mod read;
 pub mod tree;
+pub(crate) mod tree_load;
 pub mod write;
 
 pub use klems::{Frame, KlemsBasis};

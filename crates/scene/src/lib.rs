@@ -7,11 +7,13 @@ pub mod compiled;
 mod mgf;
 mod model;
 mod rad;
+mod source;
 pub mod transform;
 pub mod types;
 mod words;
 pub mod xform;
 
 pub use model::{Loc, Primitive, Scene};
-pub use rad::{decode_text, decode_text_latin1, encode_text, load, parse_str, Parser};
+pub use rad::{load, parse_str, Parser};
+pub use source::{decode_text, decode_text_latin1, encode_text};
 pub use words::parse_real;

@@ -376,7 +376,7 @@ impl State {
         } else {
             l.dir.join(name)
         };
-        let text = crate::rad::decode_text(std::fs::read(&path).with_context(|| {
+        let text = crate::source::decode_text(std::fs::read(&path).with_context(|| {
             format!(
                 "{}: cannot read included MGF file '{}'",
                 l.loc,

@@ -240,7 +240,7 @@ pub fn xform_files(
         // each input's part of the output is written in its own encoding (a Latin-1
         // file's comments go out byte for byte)
         let mut put = |out: &mut String, latin1: bool| -> Result<()> {
-            let bytes = crate::rad::encode_text(out, latin1);
+            let bytes = crate::source::encode_text(out, latin1);
             match first.as_mut() {
                 Some(held) => held.extend_from_slice(&bytes),
                 None => sink.write_all(&bytes).context("cannot write the output")?,
@@ -254,7 +254,7 @@ pub fn xform_files(
                 let mut bytes = Vec::new();
                 std::io::Read::read_to_end(&mut std::io::stdin(), &mut bytes)
                     .context("cannot read standard input")?;
-                stdin_text = Some(crate::rad::decode_text_latin1(bytes));
+                stdin_text = Some(crate::source::decode_text_latin1(bytes));
             }
             let (text, latin1) = stdin_text
                 .as_ref()
@@ -264,9 +264,9 @@ pub fn xform_files(
         } else {
             for (f, t) in files.iter().zip(texts.iter_mut()) {
                 if t.is_none() {
-                    *t = Some(crate::rad::decode_text_latin1(crate::rad::read_text_bytes(
-                        f,
-                    )?));
+                    *t = Some(crate::source::decode_text_latin1(
+                        crate::source::read_text_bytes(f)?,
+                    ));
                 }
                 let (text, latin1) = t.as_ref().map_or(("", false), |(t, l)| (t.as_str(), *l));
                 x.text(text, f, out)?;
@@ -296,7 +296,7 @@ pub fn run_inline(cmd: &str) -> Result<Option<String>> {
     }
     let mut out = Vec::new();
     xform_files(&opts, &files, &mut out)?;
-    Ok(Some(crate::rad::decode_text(out)))
+    Ok(Some(crate::source::decode_text(out)))
 }
 
 struct Xformer<'a> {
@@ -347,7 +347,7 @@ impl Xformer<'_> {
             bail!("{file}:{line}: !commands nested too deeply");
         }
         let text =
-            crate::rad::command_output(cmd).with_context(|| format!("{file}:{line}: !{cmd}"))?;
+            crate::source::command_output(cmd).with_context(|| format!("{file}:{line}: !{cmd}"))?;
         self.depth += 1;
         let r = self.text(&text, &format!("!{cmd}"), out);
         self.depth -= 1;
