@@ -11,6 +11,11 @@
 //! is a pure function of the host variables, the channels and the cached `:`
 //! constants, so both paths give the same value. Programs the inliner cannot flatten
 //! (recursion, host functions, very large expansions) have no fast code.
+//!
+//! One file on purpose (about 1 800 lines): the lowering, the relocation, the peephole
+//! pass and the run loop all match on every variant of [`Op`]; a new op is added in one
+//! place with its four cases side by side, and the run loop's `unsafe` register indexing
+//! relies on `build`'s check right above it.
 
 use std::collections::HashMap;
 

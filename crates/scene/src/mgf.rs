@@ -4,6 +4,10 @@
 //! and the surfaces `f fh sph cyl cone ring prism`. Materials map to Radiance types by
 //! the rules mgf2rad applies (light, glass, trans, plastic, metal); names follow its
 //! scheme (`object.a<k>.object.f<n>`).
+//!
+//! One file on purpose (about 1 000 lines, a third of them tests): the reader's state
+//! (material, colour, vertex and transform contexts) and mgf2rad's conversion rules are
+//! one state machine; splitting it would spread that state over modules.
 
 use crate::transform::invert3;
 use std::collections::HashMap;

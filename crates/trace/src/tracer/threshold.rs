@@ -18,6 +18,10 @@
 //! blocks of records traced in parallel and merges the blocks' changes back in record
 //! order ([`DirectState::fork`], [`DirectState::merge`]), so its output is the same for
 //! any number of threads.
+//!
+//! One file on purpose (about 930 lines): the obstructor caches, the hit statistics and
+//! the thresholded direct-light loop that reads and updates them are Radiance's `direct()`
+//! and its source tests, kept together so that the carried state is in one place.
 
 use super::*;
 use std::sync::atomic::{AtomicU32, Ordering};
