@@ -28,18 +28,7 @@ struct ModArg {
 }
 
 /// `-X`, `-X+`, `-X-`, `+X` (and `0`/`1`) forms of a toggle; `None` if `a` is not that toggle.
-fn toggle(a: &str, name: &str, cur: bool) -> Option<bool> {
-    if let Some(rest) = a.strip_prefix('+') {
-        return (rest == name).then_some(true);
-    }
-    let rest = a.strip_prefix('-')?.strip_prefix(name)?;
-    match rest {
-        "" => Some(!cur),
-        "+" | "1" => Some(true),
-        "-" | "0" => Some(false),
-        _ => None,
-    }
-}
+use fenestra_cli::opts::bool_option as toggle;
 
 fn num(args: &[String], i: usize) -> Result<f64> {
     let w = args

@@ -33,16 +33,7 @@ fn num(args: &[String], i: usize) -> Result<f64> {
         .with_context(|| format!("option {}: '{w}' is not a number", args[i - 1]))
 }
 
-fn toggle(a: &str, name: &str, cur: bool) -> Option<bool> {
-    let rest = a.get(1..)?.strip_prefix(name)?;
-    let plus = a.starts_with('+');
-    match rest {
-        "" => Some(if plus { true } else { !cur }),
-        "+" | "y" | "1" => Some(true),
-        "-" | "n" | "0" => Some(false),
-        _ => None,
-    }
-}
+use fenestra_cli::opts::bool_option as toggle;
 
 /// Runs rtrace.
 pub fn run(args: Vec<String>) -> Result<ExitCode> {

@@ -83,6 +83,22 @@ impl Opt {
     }
 }
 
+/// A Radiance boolean option `arg` named `name` (`-I`, `+I`, `-I+`, `-Iy`, `-I0` …):
+/// its new value given the `current` one, `None` when `arg` is not that option. `-name`
+/// flips, `+name` sets; a suffix `+ y Y t T 1` sets and `- n N f F 0` clears, as
+/// Radiance's `check_bool`. Every tool's toggles go through this rule.
+pub fn bool_option(arg: &str, name: &str, current: bool) -> Option<bool> {
+    let plus = arg.starts_with('+');
+    if !plus && !arg.starts_with('-') {
+        return None;
+    }
+    let rest = arg[1..].strip_prefix(name)?;
+    match toggle_char(rest)? {
+        None => Some(plus || !current),
+        Some(v) => Some(v),
+    }
+}
+
 fn toggle_char(rest: &str) -> Option<Option<bool>> {
     match rest {
         "" => Some(None),
@@ -434,6 +450,22 @@ mod tests {
             .opt(Opt::new("I", Kind::Toggle, "irradiance"))
             .opt(Opt::new("vd", Kind::Vec3, "direction"))
             .opt(Opt::new("c", Kind::Words(3), "colour"))
+    }
+
+    #[test]
+    fn bool_options_as_radiance() {
+        assert_eq!(bool_option("-I", "I", false), Some(true));
+        assert_eq!(bool_option("-I", "I", true), Some(false));
+        assert_eq!(bool_option("+I", "I", true), Some(true));
+        for on in ["-I+", "-Iy", "-IY", "-It", "-IT", "-I1", "+I1"] {
+            assert_eq!(bool_option(on, "I", false), Some(true), "{on}");
+        }
+        for off in ["-I-", "-In", "-IN", "-If", "-IF", "-I0"] {
+            assert_eq!(bool_option(off, "I", true), Some(false), "{off}");
+        }
+        assert_eq!(bool_option("-Io", "I", false), None);
+        assert_eq!(bool_option("-i", "I", false), None);
+        assert_eq!(bool_option("I", "I", false), None);
     }
 
     #[test]
