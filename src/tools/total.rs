@@ -323,8 +323,8 @@ fn total_one<W: Write>(
             let mut pending = 0;
             let mut rec = 0usize;
             loop {
-                let got =
-                    read_full(r, &mut bytes).with_context(|| format!("{name}: read error"))?;
+                let got = fenestra_formats::matrix::read_full(r, &mut bytes)
+                    .with_context(|| format!("{name}: read error"))?;
                 if got == 0 {
                     break;
                 }
@@ -402,19 +402,6 @@ fn total_one<W: Write>(
         }
     }
     Ok(())
-}
-
-fn read_full(r: &mut dyn BufRead, buf: &mut [u8]) -> std::io::Result<usize> {
-    let mut n = 0;
-    while n < buf.len() {
-        match r.read(&mut buf[n..]) {
-            Ok(0) => break,
-            Ok(k) => n += k,
-            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-            Err(e) => return Err(e),
-        }
-    }
-    Ok(n)
 }
 
 /// Runs total.

@@ -139,14 +139,7 @@ impl Reinhart {
     /// exactly on a row boundary).
     pub fn patch_of(&self, d: [f64; 3]) -> usize {
         let degree = PI / 180.0;
-        let asin = if d[2] - 1.0 > 0.0 {
-            PI / 2.0
-        } else if -1.0 - d[2] > 0.0 {
-            -PI / 2.0
-        } else {
-            d[2].asin()
-        };
-        let alt = asin * (1.0 / degree);
+        let alt = cal_asin(d[2]) * (1.0 / degree);
         if -alt > 0.0 {
             return 0;
         }
@@ -172,14 +165,7 @@ impl Reinhart {
     /// file defines as a variable, not a constant).
     pub fn sky_index_b(&self, d: [f64; 3]) -> Option<usize> {
         let degree = PI / 180.0;
-        let asin = if d[2] - 1.0 > 0.0 {
-            PI / 2.0
-        } else if -1.0 - d[2] > 0.0 {
-            -PI / 2.0
-        } else {
-            d[2].asin()
-        };
-        let alt = asin * (1.0 / degree);
+        let alt = cal_asin(d[2]) * (1.0 / degree);
         if alt <= 0.0 {
             return None;
         }
@@ -197,6 +183,17 @@ impl Reinhart {
             0
         };
         Some(self.row_start[r] - 1 + c)
+    }
+}
+
+/// The .cal library's `asin` with its argument clamped to [−1, 1] (Radiance's `Asin`).
+fn cal_asin(z: f64) -> f64 {
+    if z - 1.0 > 0.0 {
+        PI / 2.0
+    } else if -1.0 - z > 0.0 {
+        -PI / 2.0
+    } else {
+        z.asin()
     }
 }
 

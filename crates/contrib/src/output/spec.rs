@@ -52,28 +52,16 @@ impl Spec {
     /// Parses a spec; any conversion other than one `%s` and one integer field is an error.
     pub fn parse(text: &str) -> Result<Spec> {
         let (mut has_mod, mut has_bin) = (false, false);
-        let b: Vec<char> = text.chars().collect();
-        let mut i = 0;
-        while i < b.len() {
-            if b[i] == '%' {
-                i += 1;
-                if b.get(i) == Some(&'%') {
-                    i += 1;
-                    continue;
-                }
-                let start = i;
-                while i < b.len() && (b[i].is_ascii_digit() || b[i] == '-' || b[i] == '+') {
-                    i += 1;
-                }
-                let flags: String = b[start..i].iter().collect();
-                fenestra_cli::printf::check_width(text, flags.trim_start_matches(['-', '+', '0']))?;
-                match b.get(i) {
-                    Some('s') if !has_mod => has_mod = true,
-                    Some('d' | 'i' | 'o' | 'x' | 'X') if !has_bin => has_bin = true,
-                    _ => bail!("bad output format '{text}' (one %s and one %d field allowed)"),
-                }
+        for piece in pieces(text) {
+            let Piece::Field { flags, conv } = piece else {
+                continue;
+            };
+            fenestra_cli::printf::check_width(text, flags.trim_start_matches(['-', '+', '0']))?;
+            match conv {
+                Some('s') if !has_mod => has_mod = true,
+                Some('d' | 'i' | 'o' | 'x' | 'X') if !has_bin => has_bin = true,
+                _ => bail!("bad output format '{text}' (one %s and one %d field allowed)"),
             }
-            i += 1;
         }
         Ok(Spec {
             text: text.to_string(),
@@ -84,45 +72,33 @@ impl Spec {
 
     /// The destination name for a modifier and bin.
     pub fn expand(&self, modifier: &str, bin: usize) -> String {
-        let b: Vec<char> = self.text.chars().collect();
         let mut out = String::new();
-        let mut i = 0;
-        while i < b.len() {
-            if b[i] != '%' {
-                out.push(b[i]);
-                i += 1;
-                continue;
-            }
-            i += 1;
-            if b.get(i) == Some(&'%') {
-                out.push('%');
-                i += 1;
-                continue;
-            }
-            let start = i;
-            while i < b.len() && (b[i].is_ascii_digit() || b[i] == '-' || b[i] == '+') {
-                i += 1;
-            }
-            let flags: String = b[start..i].iter().collect();
+        for piece in pieces(&self.text) {
+            let (flags, conv) = match piece {
+                Piece::Text(c) => {
+                    out.push(c);
+                    continue;
+                }
+                Piece::Field { flags, conv } => (flags, conv),
+            };
             let left = flags.contains('-');
             let zero = flags.trim_start_matches(['-', '+']).starts_with('0');
             let width: usize = flags
                 .trim_start_matches(['-', '+', '0'])
                 .parse()
                 .unwrap_or(0);
-            let body = match b.get(i) {
+            let body = match conv {
                 Some('s') => modifier.to_string(),
                 Some('o') => format!("{bin:o}"),
                 Some('x') => format!("{bin:x}"),
                 Some('X') => format!("{bin:X}"),
                 _ => bin.to_string(),
             };
-            i += 1;
             let pad = width.saturating_sub(body.chars().count());
             if left {
                 out.push_str(&body);
                 out.push_str(&" ".repeat(pad));
-            } else if zero && !matches!(b.get(i - 1), Some('s')) {
+            } else if zero && conv != Some('s') {
                 out.push_str(&"0".repeat(pad));
                 out.push_str(&body);
             } else {
@@ -132,4 +108,41 @@ impl Spec {
         }
         out
     }
+}
+
+/// A piece of an output spec: a character of text (`%%` gives `%`) or a `%` field with
+/// its flags and width and its conversion letter (`None` at the end of the text).
+enum Piece {
+    Text(char),
+    Field { flags: String, conv: Option<char> },
+}
+
+/// The pieces of an output spec, in order.
+fn pieces(text: &str) -> Vec<Piece> {
+    let b: Vec<char> = text.chars().collect();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < b.len() {
+        if b[i] != '%' {
+            out.push(Piece::Text(b[i]));
+            i += 1;
+            continue;
+        }
+        i += 1;
+        if b.get(i) == Some(&'%') {
+            out.push(Piece::Text('%'));
+            i += 1;
+            continue;
+        }
+        let start = i;
+        while i < b.len() && (b[i].is_ascii_digit() || b[i] == '-' || b[i] == '+') {
+            i += 1;
+        }
+        out.push(Piece::Field {
+            flags: b[start..i].iter().collect(),
+            conv: b.get(i).copied(),
+        });
+        i += 1;
+    }
+    out
 }

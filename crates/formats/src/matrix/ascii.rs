@@ -7,6 +7,18 @@ use anyhow::{bail, Result};
 /// Longest number token accepted.
 const MAX_TOKEN: usize = 256;
 
+/// The reader's buffered bytes (empty at the end of data), retried when interrupted.
+fn fill<'r, R: BufRead + ?Sized>(r: &'r mut R, name: &str) -> Result<&'r [u8]> {
+    loop {
+        match r.fill_buf() {
+            Ok(_) => break,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(anyhow::Error::new(e).context(format!("{name}: read error"))),
+        }
+    }
+    Ok(r.fill_buf()?)
+}
+
 /// Reads the next white-space separated number; `Ok(None)` at end of data.
 pub(crate) fn next_number<R: BufRead + ?Sized>(
     r: &mut R,
@@ -16,11 +28,7 @@ pub(crate) fn next_number<R: BufRead + ?Sized>(
     tok.clear();
     // Skip white space.
     loop {
-        let buf = match r.fill_buf() {
-            Ok(b) => b,
-            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
-            Err(e) => return Err(anyhow::Error::new(e).context(format!("{name}: read error"))),
-        };
+        let buf = fill(r, name)?;
         if buf.is_empty() {
             return Ok(None);
         }
@@ -33,11 +41,7 @@ pub(crate) fn next_number<R: BufRead + ?Sized>(
     }
     // Collect the token.
     loop {
-        let buf = match r.fill_buf() {
-            Ok(b) => b,
-            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
-            Err(e) => return Err(anyhow::Error::new(e).context(format!("{name}: read error"))),
-        };
+        let buf = fill(r, name)?;
         if buf.is_empty() {
             break;
         }

@@ -10,7 +10,7 @@ mod writer;
 
 pub use ascii::{format_c_e, format_c_g};
 pub use dense::Matrix;
-pub use reader::{MatrixInfo, MatrixReader};
+pub use reader::{read_full, MatrixInfo, MatrixReader};
 pub use writer::{AsciiLayout, MatrixWriter, WriteOptions};
 
 /// How the numbers of a matrix are stored.

@@ -43,21 +43,12 @@ pub fn decode(p: [u8; 4]) -> [f64; 3] {
     ]
 }
 
-/// `(f, e)` with `d = f·2^e`, `f` in [0.5, 1) (d finite and > 0).
+/// `(f, e)` with `d = f·2^e`, `f` in [0.5, 1) (d > 0); infinity as the largest exponent.
 fn frexp(d: f64) -> (f64, i32) {
     if d.is_infinite() {
         return (0.5, 1025);
     }
-    let bits = d.to_bits();
-    let exp = ((bits >> 52) & 0x7ff) as i32;
-    if exp == 0 {
-        // Subnormal: scale up first.
-        let (f, e) = frexp(d * 2f64.powi(64));
-        return (f, e - 64);
-    }
-    let e = exp - 1022;
-    let f = f64::from_bits((bits & !(0x7ffu64 << 52)) | (1022u64 << 52));
-    (f, e)
+    crate::rgbe::frexp(d)
 }
 
 fn ldexp(x: f64, e: i32) -> f64 {
