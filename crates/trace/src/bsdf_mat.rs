@@ -2,6 +2,12 @@
 //! conventions (front = +Z = surface normal side; XML blocks mapped crosswise) and its
 //! "view vector in" evaluation order, so a room-side viewer looking out uses the
 //! `Transmission Back` block, as Radiance's renderer does.
+//!
+//! On loading, each matrix gives up its Lambertian part as Radiance's loader does: the
+//! minimum over the whole matrix (with Radiance's position factor) when above 0.01/π is
+//! subtracted from every element and kept as a diffuse reflectance or transmittance
+//! (π × minimum); a remainder whose largest hemispherical total is 0.001 or less is
+//! dropped. A file with one transmission matrix gives its Lambertian part to both sides.
 
 use std::sync::Arc;
 
@@ -10,7 +16,7 @@ use fenestra_bsdf::{Direction, KlemsMatrix, Wavelength};
 use fenestra_scene::Primitive;
 use glam::DVec3;
 
-/// One Klems component ready for evaluation and sampling.
+/// One Klems component (its non-diffuse remainder) ready for evaluation and sampling.
 #[derive(Debug)]
 pub struct Component {
     m: KlemsMatrix,
@@ -20,6 +26,8 @@ pub struct Component {
     out_back: bool,
     /// Whether the incident (view) vector is on the back side.
     in_back: bool,
+    /// Largest directional-hemispherical total over incident patches.
+    pub max_hemi: f64,
 }
 
 /// A compiled BSDF material.
@@ -35,12 +43,29 @@ pub struct BsdfMat {
     pub tf: Option<Arc<Component>>,
     /// Transmission for a viewer on the back side (XML Transmission Front).
     pub tb: Option<Arc<Component>>,
-    /// Extra diffuse reflectance front, back, and diffuse transmittance (real arguments).
+    /// Diffuse reflectance (hemispherical) of the front side: the real arguments plus the
+    /// Lambertian part of the front reflection matrix.
     pub rd_front: DVec3,
-    /// Extra diffuse reflectance of the back side.
+    /// Diffuse reflectance of the back side (arguments plus Lambertian part).
     pub rd_back: DVec3,
-    /// Extra diffuse transmittance.
-    pub td: DVec3,
+    /// Diffuse transmittance for a viewer on the front side (arguments plus Lambertian part).
+    pub td_front: DVec3,
+    /// Diffuse transmittance for a viewer on the back side.
+    pub td_back: DVec3,
+}
+
+/// A matrix split as Radiance's loader does: the non-diffuse remainder (if kept) and the
+/// hemispherical Lambertian part (π × the minimum split off).
+fn split(m: &KlemsMatrix) -> (Option<KlemsMatrix>, f64) {
+    let (lamb, keep) = fenestra_bsdf::radiance::lambertian_split(m);
+    let rest = keep.then(|| {
+        let mut r = m.clone();
+        for v in &mut r.values {
+            *v = (*v - lamb).max(0.0);
+        }
+        r
+    });
+    (rest, std::f64::consts::PI * lamb)
 }
 
 fn flip(v: DVec3, x: bool, z: bool) -> [f64; 3] {
@@ -54,7 +79,7 @@ impl Component {
         let lam: Vec<f64> = (0..m.outgoing.len())
             .map(|o| m.outgoing.projected_solid_angle(o).unwrap_or(0.0))
             .collect();
-        let cdf = (0..ni)
+        let cdf: Vec<Vec<f64>> = (0..ni)
             .map(|i| {
                 let mut acc = 0.0;
                 lam.iter()
@@ -66,12 +91,36 @@ impl Component {
                     .collect()
             })
             .collect();
+        let max_hemi = cdf
+            .iter()
+            .map(|c: &Vec<f64>| c.last().copied().unwrap_or(0.0))
+            .fold(0.0, f64::max);
         Component {
             m,
             cdf,
             out_back,
             in_back,
+            max_hemi,
         }
+    }
+
+    /// Directional-hemispherical total (Σ BSDF·λ) for view `v`; 0 outside the basis.
+    pub fn hemi(&self, v: DVec3) -> f64 {
+        self.in_index(v)
+            .and_then(|i| self.cdf[i].last().copied())
+            .unwrap_or(0.0)
+    }
+
+    /// Projected solid angle of the incident patch holding view `v`.
+    pub fn view_patch_size(&self, v: DVec3) -> Option<f64> {
+        self.in_index(v)
+            .and_then(|i| self.m.incident.projected_solid_angle(i))
+    }
+
+    /// Projected solid angle of the outgoing patch holding light direction `l`.
+    pub fn light_patch_size(&self, l: DVec3) -> Option<f64> {
+        self.out_index(l)
+            .and_then(|o| self.m.outgoing.projected_solid_angle(o))
     }
 
     /// Incident index of a view vector `v` (local, pointing away from the surface).
@@ -157,15 +206,37 @@ pub fn compile(p: &Primitive) -> Result<BsdfMat> {
     {
         bail!("{}: BSDF '{}': tensor-tree BSDF files are not supported by fenestra's ray tracer (Klems only)", p.loc, p.name);
     }
-    let get = |d: Direction, in_back: bool, out_back: bool| {
-        b.klems(d, &vis)
-            .map(|m| Arc::new(Component::new(m.clone(), in_back, out_back)))
+    let get = |d: Direction, in_back: bool, out_back: bool| match b.klems(d, &vis) {
+        None => (None, 0.0),
+        Some(m) => {
+            let (rest, lamb) = split(m);
+            (
+                rest.map(|r| Arc::new(Component::new(r, in_back, out_back))),
+                lamb,
+            )
+        }
     };
-    let rf = get(Direction::ReflectionBack, false, false);
-    let rb = get(Direction::ReflectionFront, true, true);
-    let tf = get(Direction::TransmissionBack, false, true);
-    let tb = get(Direction::TransmissionFront, true, false);
-    if rf.is_none() && rb.is_none() && tf.is_none() && tb.is_none() {
+    let (rf, l_rf) = get(Direction::ReflectionBack, false, false);
+    let (rb, l_rb) = get(Direction::ReflectionFront, true, true);
+    let (tf, mut l_tf) = get(Direction::TransmissionBack, false, true);
+    let (tb, mut l_tb) = get(Direction::TransmissionFront, true, false);
+    // one transmission matrix: its Lambertian part serves both sides, as in Radiance
+    let has = |d: Direction| b.klems(d, &vis).is_some();
+    if !has(Direction::TransmissionBack) {
+        l_tf = l_tb;
+    }
+    if !has(Direction::TransmissionFront) {
+        l_tb = l_tf;
+    }
+    let any = [
+        Direction::ReflectionBack,
+        Direction::ReflectionFront,
+        Direction::TransmissionBack,
+        Direction::TransmissionFront,
+    ]
+    .into_iter()
+    .any(has);
+    if !any {
         bail!(
             "{}: BSDF '{}': '{}' has no visible Klems data",
             p.loc,
@@ -187,8 +258,9 @@ pub fn compile(p: &Primitive) -> Result<BsdfMat> {
         rb,
         tf,
         tb,
-        rd_front: v3(0),
-        rd_back: v3(3),
-        td: v3(6),
+        rd_front: v3(0) + DVec3::splat(l_rf),
+        rd_back: v3(3) + DVec3::splat(l_rb),
+        td_front: v3(6) + DVec3::splat(l_tf),
+        td_back: v3(6) + DVec3::splat(l_tb),
     })
 }
