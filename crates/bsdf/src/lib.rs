@@ -9,6 +9,7 @@ pub mod radiance;
 pub mod read;
 pub mod tree;
 pub(crate) mod tree_load;
+pub mod tree_render;
 pub mod write;
 
 pub use klems::{Frame, KlemsBasis};

@@ -211,24 +211,7 @@ impl Tree {
     /// Orders a direction pair for this tree (`a` where light comes from as Radiance's tree
     /// query names it); `None` when the pair is not on this component's sides.
     pub(crate) fn orient(&self, a: [f64; 3], b: [f64; 3]) -> Option<([f64; 3], [f64; 3])> {
-        match self.side {
-            Side::IntRefl => (b[2] >= 0.0 && a[2] >= 0.0).then_some((a, b)),
-            Side::ExtRefl => (b[2] <= 0.0 && a[2] <= 0.0).then_some((a, b)),
-            Side::IntExt => {
-                if b[2] > 0.0 {
-                    (a[2] <= 0.0).then_some((b, a))
-                } else {
-                    (a[2] >= 0.0).then_some((a, b))
-                }
-            }
-            Side::ExtInt => {
-                if a[2] > 0.0 {
-                    (b[2] <= 0.0).then_some((b, a))
-                } else {
-                    (b[2] >= 0.0).then_some((a, b))
-                }
-            }
-        }
+        orient(self.side, a, b)
     }
 
     /// The leaf for the pair `(a, b)` in Radiance's tree-query order.
@@ -252,20 +235,7 @@ impl Tree {
 
     /// Tree coordinates of the oriented pair (`i` where the tree's light comes from).
     pub(crate) fn position(&self, i: [f64; 3], o: [f64; 3]) -> [f64; 4] {
-        let mut pos = [0.0; 4];
-        if self.rank == 3 {
-            let theta = -(-i[1]).atan2(-i[0]);
-            let r = spin_z(o, theta);
-            pos[0] = (0.5 - TINY) - 0.5 * (i[0] * i[0] + i[1] * i[1]).sqrt();
-            let (u, v) = disk_to_square(r[0], r[1]);
-            pos[1] = u;
-            pos[2] = v;
-        } else {
-            let (u, v) = disk_to_square(-i[0], -i[1]);
-            let (s, t) = disk_to_square(o[0], o[1]);
-            pos = [u, v, s, t];
-        }
-        pos
+        position(self.rank, i, o)
     }
 
     /// The tree's BSDF coefficients for the pair as Radiance returns them: one (grey) or three
@@ -275,12 +245,7 @@ impl Tree {
         // The reference scales a leaf's value by 1 + 1e-4·d, d the sum over the dimensions
         // (last first) of frac(2^(i+1) / (corner_i + 0.01687)) − 1/2: a fixed jitter from the
         // leaf's position, rounded to float with the value.
-        let mut d = 0.0;
-        for i in (0..self.rank).rev() {
-            let x = f64::from(2u32 << i) / (leaf.corner[i] + 0.01687);
-            d += x - x.trunc() - 0.5;
-        }
-        let y = (f64::from(leaf.value) * (1.0 + 1e-4 * d)) as f32;
+        let y = leaf_value(self.rank, &leaf);
         let (Some(u), Some(v)) = (&self.u, &self.v) else {
             return Some(([y, 0.0, 0.0], 1));
         };
@@ -645,4 +610,58 @@ pub struct Lambertian {
     pub y: f64,
     /// CIE X, Y, Z (grey: all equal to `y`).
     pub xyz: [f64; 3],
+}
+
+/// Orders a direction pair for a component on `side` (`a` where light comes from as
+/// Radiance's tree query names it); `None` when the pair is not on that component's sides.
+pub(crate) fn orient(side: Side, a: [f64; 3], b: [f64; 3]) -> Option<([f64; 3], [f64; 3])> {
+    match side {
+        Side::IntRefl => (b[2] >= 0.0 && a[2] >= 0.0).then_some((a, b)),
+        Side::ExtRefl => (b[2] <= 0.0 && a[2] <= 0.0).then_some((a, b)),
+        Side::IntExt => {
+            if b[2] > 0.0 {
+                (a[2] <= 0.0).then_some((b, a))
+            } else {
+                (a[2] >= 0.0).then_some((a, b))
+            }
+        }
+        Side::ExtInt => {
+            if a[2] > 0.0 {
+                (b[2] <= 0.0).then_some((b, a))
+            } else {
+                (b[2] >= 0.0).then_some((a, b))
+            }
+        }
+    }
+}
+
+/// Tree coordinates of an oriented pair (`i` where the tree's light comes from) in a tree
+/// of `rank` 3 (isotropic: the radius of `i` and `o` turned by `i`'s azimuth) or 4.
+pub(crate) fn position(rank: usize, i: [f64; 3], o: [f64; 3]) -> [f64; 4] {
+    let mut pos = [0.0; 4];
+    if rank == 3 {
+        let theta = -(-i[1]).atan2(-i[0]);
+        let r = spin_z(o, theta);
+        pos[0] = (0.5 - TINY) - 0.5 * (i[0] * i[0] + i[1] * i[1]).sqrt();
+        let (u, v) = disk_to_square(r[0], r[1]);
+        pos[1] = u;
+        pos[2] = v;
+    } else {
+        let (u, v) = disk_to_square(-i[0], -i[1]);
+        let (s, t) = disk_to_square(o[0], o[1]);
+        pos = [u, v, s, t];
+    }
+    pos
+}
+
+/// A leaf's value as Radiance returns it: scaled by `1 + 1e-4·d`, d the sum over the
+/// dimensions (last first) of frac(2^(i+1) / (corner_i + 0.01687)) − 1/2, a fixed jitter
+/// from the leaf's position that keeps equal leaves apart, rounded to single precision.
+pub(crate) fn leaf_value(rank: usize, leaf: &Leaf) -> f32 {
+    let mut d = 0.0;
+    for i in (0..rank).rev() {
+        let x = f64::from(2u32 << i) / (leaf.corner[i] + 0.01687);
+        d += x - x.trunc() - 0.5;
+    }
+    (f64::from(leaf.value) * (1.0 + 1e-4 * d)) as f32
 }

@@ -12,6 +12,7 @@
 use std::sync::Arc;
 
 use anyhow::{bail, Context, Result};
+use fenestra_bsdf::tree_render::{Lobe, TreeBsdf};
 use fenestra_bsdf::{Direction, KlemsMatrix, Wavelength};
 use fenestra_scene::Primitive;
 use glam::DVec3;
@@ -52,6 +53,108 @@ pub struct BsdfMat {
     pub td_front: DVec3,
     /// Diffuse transmittance for a viewer on the back side.
     pub td_back: DVec3,
+    /// Tensor-tree data (the Klems components are then absent).
+    pub tree: Option<Arc<TreeBsdf>>,
+    /// The file's own Lambertian parts (hemispherical): reflection front, reflection back,
+    /// transmission for a front view, transmission for a back view.
+    pub lamb: [f64; 4],
+}
+
+/// One lobe of a BSDF material as a view on one side sees it: a Klems component or a
+/// tensor tree's.
+#[derive(Clone, Copy)]
+pub enum LobeData<'a> {
+    /// A Klems matrix (its non-diffuse remainder).
+    Klems(&'a Component),
+    /// A tensor tree.
+    Tree(&'a TreeBsdf, Lobe, bool),
+}
+
+impl LobeData<'_> {
+    /// Largest hemispherical total over views (an upper bound for trees).
+    pub fn max_hemi(&self) -> f64 {
+        match self {
+            LobeData::Klems(c) => c.max_hemi,
+            LobeData::Tree(..) => f64::INFINITY,
+        }
+    }
+
+    /// Projected solid angle of the cell holding view `v` (a Klems patch; a tree's smallest
+    /// leaf in the view's slice).
+    pub fn view_size(&self, v: DVec3) -> f64 {
+        match self {
+            LobeData::Klems(c) => c.view_patch_size(v).unwrap_or(0.0),
+            LobeData::Tree(t, lobe, front) => t
+                .slice(*lobe, *front, v.to_array())
+                .map_or(0.0, |s| s.smallest()),
+        }
+    }
+
+    /// Directional-hemispherical total for view `v`.
+    pub fn hemi(&self, v: DVec3) -> f64 {
+        match self {
+            LobeData::Klems(c) => c.hemi(v),
+            LobeData::Tree(t, lobe, front) => t
+                .slice(*lobe, *front, v.to_array())
+                .map_or(0.0, |s| s.total()),
+        }
+    }
+
+    /// A direction for view `v` drawn in proportion to the BSDF × projected solid angle,
+    /// with the view's hemispherical total.
+    pub fn sample(&self, v: DVec3, u: f64, u0: f64, u1: f64) -> Option<(DVec3, f64)> {
+        match self {
+            LobeData::Klems(c) => c.sample(v, u, u0, u1),
+            LobeData::Tree(t, lobe, front) => {
+                let s = t.slice(*lobe, *front, v.to_array())?;
+                let d = s.sample(u, u0, u1)?;
+                Some((DVec3::from(d), s.total()))
+            }
+        }
+    }
+
+    /// BSDF value (sr⁻¹) for view `v` and light `l`, and the projected solid angle over
+    /// which Radiance jitters the view for it (the smaller of the two Klems patches; the
+    /// tree's leaf holding the pair).
+    pub fn eval_sized(&self, v: DVec3, l: DVec3) -> (f64, f64) {
+        match self {
+            LobeData::Klems(c) => {
+                let size = c
+                    .view_patch_size(v)
+                    .zip(c.light_patch_size(l))
+                    .map_or(0.0, |(a, b)| a.min(b));
+                (c.eval(v, l), size)
+            }
+            LobeData::Tree(t, lobe, front) => t.eval(*lobe, *front, v.to_array(), l.to_array()),
+        }
+    }
+
+    /// BSDF value (sr⁻¹) for view `v` and light `l`.
+    pub fn eval(&self, v: DVec3, l: DVec3) -> f64 {
+        match self {
+            LobeData::Klems(c) => c.eval(v, l),
+            LobeData::Tree(t, lobe, front) => t.eval(*lobe, *front, v.to_array(), l.to_array()).0,
+        }
+    }
+}
+
+impl BsdfMat {
+    /// The (reflection, transmission) lobes for a view on the front or back side.
+    pub fn lobes(&self, front: bool) -> (Option<LobeData<'_>>, Option<LobeData<'_>>) {
+        if let Some(t) = &self.tree {
+            let get = |lobe| t.has(lobe, front).then_some(LobeData::Tree(t, lobe, front));
+            return (get(Lobe::Reflection), get(Lobe::Transmission));
+        }
+        let (r, tr) = if front {
+            (&self.rf, &self.tf)
+        } else {
+            (&self.rb, &self.tb)
+        };
+        (
+            r.as_deref().map(LobeData::Klems),
+            tr.as_deref().map(LobeData::Klems),
+        )
+    }
 }
 
 /// A matrix split as Radiance's loader does: the non-diffuse remainder (if kept) and the
@@ -199,12 +302,34 @@ pub fn compile(p: &Primitive) -> Result<BsdfMat> {
     let b = fenestra_bsdf::read_file(&path)
         .map_err(|e| anyhow::anyhow!("{}: BSDF '{}': {e}", p.loc, p.name))?;
     let vis = Wavelength::Visible;
-    if b.blocks
-        .iter()
-        .any(|bl| matches!(bl.data, fenestra_bsdf::BlockData::Tree(_)))
-        && b.klems(Direction::TransmissionFront, &vis).is_none()
-    {
-        bail!("{}: BSDF '{}': tensor-tree BSDF files are not supported by fenestra's ray tracer (Klems only)", p.loc, p.name);
+    let r = &p.rargs;
+    let v3 = |k: usize| {
+        if r.len() >= k + 3 {
+            DVec3::new(r[k], r[k + 1], r[k + 2])
+        } else {
+            DVec3::ZERO
+        }
+    };
+    if let Some(t) = TreeBsdf::load(&b) {
+        let l = |lobe, front| DVec3::splat(t.lambertian(lobe, front));
+        return Ok(BsdfMat {
+            up,
+            rf: None,
+            rb: None,
+            tf: None,
+            tb: None,
+            rd_front: v3(0) + l(Lobe::Reflection, true),
+            rd_back: v3(3) + l(Lobe::Reflection, false),
+            td_front: v3(6) + l(Lobe::Transmission, true),
+            td_back: v3(6) + l(Lobe::Transmission, false),
+            lamb: [
+                t.lambertian(Lobe::Reflection, true),
+                t.lambertian(Lobe::Reflection, false),
+                t.lambertian(Lobe::Transmission, true),
+                t.lambertian(Lobe::Transmission, false),
+            ],
+            tree: Some(Arc::new(t)),
+        });
     }
     let get = |d: Direction, in_back: bool, out_back: bool| match b.klems(d, &vis) {
         None => (None, 0.0),
@@ -244,14 +369,6 @@ pub fn compile(p: &Primitive) -> Result<BsdfMat> {
             path.display()
         );
     }
-    let r = &p.rargs;
-    let v3 = |k: usize| {
-        if r.len() >= k + 3 {
-            DVec3::new(r[k], r[k + 1], r[k + 2])
-        } else {
-            DVec3::ZERO
-        }
-    };
     Ok(BsdfMat {
         up,
         rf,
@@ -262,5 +379,7 @@ pub fn compile(p: &Primitive) -> Result<BsdfMat> {
         rd_back: v3(3) + DVec3::splat(l_rb),
         td_front: v3(6) + DVec3::splat(l_tf),
         td_back: v3(6) + DVec3::splat(l_tb),
+        tree: None,
+        lamb: [l_rf, l_rb, l_tf, l_tb],
     })
 }

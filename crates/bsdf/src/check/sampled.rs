@@ -277,9 +277,9 @@ pub use crate::tree_load::Lambertian;
 /// A tensor-tree file as the reference loads it: the `Visible` trees (and CIE-u/v trees of
 /// coloured components) with their Lambertian parts split off, indexed like `SIDES`.
 pub struct TreeFile {
-    rank: usize,
-    trees: [Option<Tree>; 4],
-    lamb: [Lambertian; 4],
+    pub(crate) rank: usize,
+    pub(crate) trees: [Option<Tree>; 4],
+    pub(crate) lamb: [Lambertian; 4],
     /// Largest directional-hemispherical total (Lambertian part included).
     max_hemi: [Option<f64>; 4],
     /// Per component: (directional total at normal incidence, total for diffuse incidence,

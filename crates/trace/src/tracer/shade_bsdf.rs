@@ -17,7 +17,7 @@
 //!   diffuse transmittance (plus unsampled transmission) on the other.
 
 use super::*;
-use crate::bsdf_mat::Component;
+use crate::bsdf_mat::LobeData;
 
 /// A view `v` (local, unit) moved by up to `radius`/2 in local x and y (`u`, `w` uniform
 /// in [0, 1)), renormalised; the side (sign of z) is kept.
@@ -50,10 +50,11 @@ impl Tracer {
         let to_local = |w: DVec3| DVec3::new(w.dot(x), w.dot(y), w.dot(z));
         let v = to_local(-r.dir);
         let front = v.z > 0.0;
-        let (refl, trans, rd, td) = if front {
-            (b.rf.as_deref(), b.tf.as_deref(), b.rd_front, b.td_front)
+        let (refl, trans) = b.lobes(front);
+        let (rd, td) = if front {
+            (b.rd_front, b.td_front)
         } else {
-            (b.rb.as_deref(), b.tb.as_deref(), b.rd_back, b.td_back)
+            (b.rd_back, b.td_back)
         };
         let side = if front { z } else { -z };
         let (ss, st) = (self.opts.ss.max(0.0), self.opts.st);
@@ -66,24 +67,47 @@ impl Tracer {
         } else {
             1
         };
-        let remainder = |c: &Component, ll: DVec3| {
-            let Some(tomega) = c.view_patch_size(v).zip(c.light_patch_size(ll)) else {
-                return 0.0;
-            };
-            let radius = tomega.0.min(tomega.1).sqrt() * shrink;
+        // the non-diffuse part for light from `ll`, as Radiance's direct_specular_OK: the
+        // full BSDF (file's Lambertian part `diff_y` included) averaged over jittered
+        // views; a view whose value is no more than the Lambertian part counts as zero, one
+        // landing in a cell under 0.12 of the first's size (a finer tree leaf) is left
+        // out; then the Lambertian part is taken off again
+        let remainder = |c: &LobeData, ll: DVec3, diff_y: f64| {
+            let (f0, tomega) = c.eval_sized(v, ll);
+            let radius = tomega.max(0.0).sqrt() * shrink;
+            if radius <= 0.0 {
+                return f0;
+            }
             let mut g = jit.borrow_mut();
-            let mut sum = 0.0;
+            let (mut sum, mut count) = (0.0, 0usize);
             for _ in 0..nview {
                 let (u, w) = (g.next_f64(), g.next_f64());
-                sum += c.eval(jitter(v, radius, u, w), ll);
+                let (f, size) = c.eval_sized(jitter(v, radius, u, w), ll);
+                if f <= FTINY {
+                    count += 1;
+                    continue;
+                }
+                if size < 0.12 * tomega {
+                    continue;
+                }
+                sum += f + diff_y;
+                count += 1;
             }
-            sum / nview as f64
+            if count == 0 {
+                return 0.0;
+            }
+            (sum / count as f64 - diff_y).max(0.0)
         };
         let lobe = |l: DVec3, omega: f64, ldot: f64| {
             let ll = to_local(l);
             let same = (ll.z > 0.0) == front;
-            let (comp, diffuse) = if same { (refl, rd) } else { (trans, td) };
-            let f = DVec3::splat(comp.map_or(0.0, |c| remainder(c, ll))) + diffuse / PI;
+            let (comp, diffuse, own) = if same {
+                (refl, rd, b.lamb[usize::from(!front)])
+            } else {
+                (trans, td, b.lamb[2 + usize::from(!front)])
+            };
+            let f = DVec3::splat(comp.as_ref().map_or(0.0, |c| remainder(c, ll, own / PI)))
+                + diffuse / PI;
             f * (ldot.abs() * omega)
         };
         // with thresholding direct light comes last (as in Radiance), otherwise first
@@ -98,10 +122,10 @@ impl Tracer {
         let (mut rdiff, mut tdiff) = (rd, td);
         for (comp, flag) in [(refl, REFLECTED), (trans, TRANS)] {
             let Some(c) = comp else { continue };
-            if c.max_hemi <= FTINY {
+            if c.max_hemi() <= FTINY {
                 continue;
             }
-            let big = c.view_patch_size(v).unwrap_or(0.0).sqrt() * shrink;
+            let big = c.view_size(v).sqrt() * shrink;
             let (u, w) = (cx.rng.next_f64(), cx.rng.next_f64());
             let total = c.hemi(jitter(v, big, u, w));
             if total <= st + FTINY {

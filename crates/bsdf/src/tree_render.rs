@@ -1,0 +1,303 @@
+//! Tensor-tree BSDFs for rendering (grey, the `Visible` trees): values at the nearest leaf
+//! with Radiance's position factor, after the Lambertian parts Radiance's loader splits
+//! off (`tree_load`), and the outgoing distribution of a view (the tree's slice at the
+//! view's incident position) for hemispherical totals and importance sampling. Local
+//! frame as Radiance's: +Z is the normal side (the XML back, interior); directions point
+//! away from the surface; the view vector takes the place of the incident one
+//! (reciprocity), as Radiance's renderer queries BSDFs.
+
+use std::collections::HashMap;
+use std::f64::consts::PI;
+use std::sync::{Arc, Mutex};
+
+use crate::check::sampled::TreeFile;
+use crate::model::Bsdf;
+use crate::tree::{disk_to_square, leaf_at, smallest_leaf_edge, square_to_disk, Node};
+use crate::tree_load::{leaf_value, orient, position, spin_z, Side};
+
+/// A lobe of a BSDF seen from one side.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Lobe {
+    /// Light returned to the view's side.
+    Reflection,
+    /// Light passed to the other side.
+    Transmission,
+}
+
+/// One component's grey tree.
+#[derive(Debug)]
+struct Comp {
+    rank: usize,
+    side: Side,
+    root: Node,
+    /// Edge of the smallest leaf: views in the same cell of this size share a slice.
+    finest: f64,
+}
+
+/// The leaves of one slice: (cumulative weight, lower corner in the free dimensions, edge).
+type Cells = Vec<(f64, [f64; 2], f64)>;
+
+/// A slice's cache key: component, whether it is used in its own direction, incident cell.
+type SliceKey = (usize, bool, u32, u32);
+
+/// Most slices kept per BSDF (each a few kilobytes): memory stays bounded whatever the
+/// tree's resolution; slices past the limit are computed each time.
+const MAX_CACHED: usize = 1 << 14;
+
+/// A tensor-tree BSDF ready for rendering.
+#[derive(Debug)]
+pub struct TreeBsdf {
+    /// Indexed like the sides: interior reflection, exterior reflection, interior to
+    /// exterior transmission, exterior to interior transmission.
+    comps: [Option<Comp>; 4],
+    /// Hemispherical Lambertian part (π × the value split off) per component.
+    lamb: [f64; 4],
+    /// Slices already computed, by component, direction of use and incident cell.
+    cache: Mutex<HashMap<SliceKey, Arc<Cells>>>,
+}
+
+/// The components a view on the front (+Z) or back side uses for `lobe`: the preferred one
+/// and, for transmission, the other side's tree through reciprocity.
+fn candidates(lobe: Lobe, front: bool) -> &'static [usize] {
+    match (lobe, front) {
+        (Lobe::Reflection, true) => &[0],
+        (Lobe::Reflection, false) => &[1],
+        (Lobe::Transmission, true) => &[2, 3],
+        (Lobe::Transmission, false) => &[3, 2],
+    }
+}
+
+impl TreeBsdf {
+    /// The tensor trees of a read file (`None` for a Klems file).
+    pub fn load(b: &Bsdf) -> Option<TreeBsdf> {
+        let f = TreeFile::load(b)?;
+        let lamb = std::array::from_fn(|k| f.lamb[k].y);
+        let comps = f.trees.map(|t| {
+            t.map(|t| Comp {
+                rank: t.rank,
+                side: t.side,
+                finest: smallest_leaf_edge(&t.root),
+                root: t.root,
+            })
+        });
+        Some(TreeBsdf {
+            comps,
+            lamb,
+            cache: Mutex::new(HashMap::new()),
+        })
+    }
+
+    /// The hemispherical Lambertian part of `lobe` for a view on the front or back side.
+    pub fn lambertian(&self, lobe: Lobe, front: bool) -> f64 {
+        self.lamb[candidates(lobe, front)[0]]
+    }
+
+    /// Whether the lobe has a tree (its own or, for transmission, the other side's).
+    pub fn has(&self, lobe: Lobe, front: bool) -> bool {
+        candidates(lobe, front)
+            .iter()
+            .any(|&k| self.comps[k].is_some())
+    }
+
+    /// BSDF value (sr⁻¹, Lambertian part removed) for view `v` and light `l`, and the
+    /// projected solid angle of the leaf holding the pair.
+    pub fn eval(&self, lobe: Lobe, front: bool, v: [f64; 3], l: [f64; 3]) -> (f64, f64) {
+        for &k in candidates(lobe, front) {
+            let Some(c) = &self.comps[k] else { continue };
+            if let Some((i, o)) = orient(c.side, v, l) {
+                let leaf = leaf_at(&c.root, c.rank, &position(c.rank, i, o));
+                let value = f64::from(leaf_value(c.rank, &leaf)).max(0.0);
+                return (value, PI * leaf.edge * leaf.edge);
+            }
+        }
+        (0.0, 0.0)
+    }
+
+    /// The distribution of `lobe` for view `v`: every leaf of the tree's slice at the
+    /// view's position, with its share of the hemispherical total.
+    pub fn slice(&self, lobe: Lobe, front: bool, v: [f64; 3]) -> Option<Slice> {
+        let &k = candidates(lobe, front)
+            .iter()
+            .find(|&&k| self.comps[k].is_some())?;
+        let c = self.comps[k].as_ref()?;
+        let own = k == candidates(lobe, front)[0];
+        // outgoing side of the tree's own orientation: interior (+Z) for interior
+        // reflection and exterior-to-interior transmission
+        let out_sign = match c.side {
+            Side::IntRefl | Side::ExtInt => 1.0,
+            Side::ExtRefl | Side::IntExt => -1.0,
+        };
+        let mut s = Slice {
+            cells: Arc::new(Vec::new()),
+            total: 0.0,
+            rank: c.rank,
+            theta: 0.0,
+            reverse: !own,
+            sign: if own { out_sign } else { -out_sign },
+        };
+        let mut fixed = [0.0; 4];
+        let mask: u32;
+        if c.rank == 4 {
+            if own {
+                let (u, w) = disk_to_square(-v[0], -v[1]);
+                fixed[0] = u;
+                fixed[1] = w;
+                mask = 0b0011;
+            } else {
+                let (u, w) = disk_to_square(v[0], v[1]);
+                fixed[2] = u;
+                fixed[3] = w;
+                mask = 0b1100;
+            }
+        } else {
+            if !own {
+                return None; // a rank-3 tree used in reverse: not sampled
+            }
+            s.theta = -(-v[1]).atan2(-v[0]);
+            fixed[0] = (0.5 - 1e-6) - 0.5 * (v[0] * v[0] + v[1] * v[1]).sqrt();
+            mask = 0b0001;
+        }
+        // views in the same finest incident cell meet the same leaves
+        let fixed_dims: Vec<usize> = (0..c.rank).filter(|i| mask >> i & 1 == 1).collect();
+        let q = |x: f64| (x / c.finest).clamp(0.0, f64::from(u32::MAX - 1)) as u32;
+        let key = (
+            k,
+            own,
+            q(fixed[fixed_dims[0]]),
+            fixed_dims.get(1).map_or(0, |&d| q(fixed[d])),
+        );
+        let cached = self.cache.lock().ok().and_then(|m| m.get(&key).cloned());
+        let cells = match cached {
+            Some(cells) => cells,
+            None => {
+                let free: Vec<usize> = (0..c.rank).filter(|i| mask >> i & 1 == 0).collect();
+                let mut cells: Cells = Vec::new();
+                let mut total = 0.0;
+                slice_leaves(
+                    &c.root,
+                    c.rank,
+                    mask,
+                    &fixed,
+                    &[0.0; 4],
+                    1.0,
+                    &mut |val, cmin, edge| {
+                        let w = f64::from(val).max(0.0) * PI * edge * edge;
+                        if w > 0.0 {
+                            total += w;
+                            cells.push((total, [cmin[free[0]], cmin[free[1]]], edge));
+                        }
+                    },
+                );
+                let cells = Arc::new(cells);
+                if let Ok(mut m) = self.cache.lock() {
+                    if m.len() < MAX_CACHED {
+                        m.insert(key, cells.clone());
+                    }
+                }
+                cells
+            }
+        };
+        s.total = cells.last().map_or(0.0, |c| c.0);
+        s.cells = cells;
+        Some(s)
+    }
+}
+
+/// The leaves of a tree's slice at the coordinates `fixed` in the dimensions of `mask`,
+/// each with its value, lower corner and edge.
+fn slice_leaves(
+    node: &Node,
+    rank: usize,
+    mask: u32,
+    fixed: &[f64; 4],
+    cmin: &[f64; 4],
+    csiz: f64,
+    f: &mut dyn FnMut(f32, &[f64; 4], f64),
+) {
+    let inside = |lo: &[f64; 4], size: f64| {
+        (0..rank).all(|i| {
+            mask >> i & 1 == 0
+                || (fixed[i] >= lo[i] && (fixed[i] < lo[i] + size || lo[i] + size >= 1.0))
+        })
+    };
+    match node {
+        Node::Branch(ch) => {
+            let half = 0.5 * csiz;
+            for (n, c) in ch.iter().enumerate() {
+                let mut lo = *cmin;
+                for (i, l) in lo.iter_mut().enumerate().take(rank) {
+                    if n >> i & 1 == 1 {
+                        *l += half;
+                    }
+                }
+                if inside(&lo, half) {
+                    slice_leaves(c, rank, mask, fixed, &lo, half, f);
+                }
+            }
+        }
+        Node::Grid { log2, values } => {
+            let cells = 1usize << log2;
+            let cell = csiz / cells as f64;
+            for (k, &val) in values.iter().enumerate() {
+                let mut lo = *cmin;
+                for (i, l) in lo.iter_mut().enumerate().take(rank) {
+                    let ci = k / cells.pow((rank - 1 - i) as u32) % cells;
+                    *l += cell * ci as f64;
+                }
+                if inside(&lo, cell) {
+                    f(val, &lo, cell);
+                }
+            }
+        }
+    }
+}
+
+/// The outgoing distribution of one view (see [`TreeBsdf::slice`]).
+#[derive(Debug)]
+pub struct Slice {
+    /// (cumulative weight, lower corner in the free dimensions, edge) per leaf.
+    cells: Arc<Cells>,
+    total: f64,
+    rank: usize,
+    theta: f64,
+    reverse: bool,
+    sign: f64,
+}
+
+impl Slice {
+    /// Directional-hemispherical total (Σ value · projected solid angle).
+    pub fn total(&self) -> f64 {
+        self.total
+    }
+
+    /// Projected solid angle of the smallest leaf of the slice (0 when empty).
+    pub fn smallest(&self) -> f64 {
+        self.cells
+            .iter()
+            .map(|c| PI * c.2 * c.2)
+            .fold(f64::INFINITY, f64::min)
+            .min(PI)
+            * f64::from(u8::from(!self.cells.is_empty()))
+    }
+
+    /// A direction drawn in proportion to value × projected solid angle: `x` picks the
+    /// leaf, `u`, `w` the point in it (uniform in projected solid angle).
+    pub fn sample(&self, x: f64, u: f64, w: f64) -> Option<[f64; 3]> {
+        if self.total <= 0.0 {
+            return None;
+        }
+        let t = x * self.total;
+        let k = self
+            .cells
+            .partition_point(|c| c.0 <= t)
+            .min(self.cells.len() - 1);
+        let (_, lo, edge) = self.cells[k];
+        let (sx, sy) = square_to_disk(lo[0] + u * edge, lo[1] + w * edge);
+        let z = self.sign * (1.0 - sx * sx - sy * sy).max(0.0).sqrt();
+        Some(match (self.rank, self.reverse) {
+            (4, false) => [sx, sy, z],
+            (4, true) => [-sx, -sy, z],
+            _ => spin_z([sx, sy, z], -self.theta),
+        })
+    }
+}
