@@ -251,3 +251,45 @@ fn bsdf_hard_cases_stay_finite() {
         }
     }
 }
+
+/// A BSDF with a thickness is a proxy: view rays pass straight through (here to the sun
+/// and the glow sky behind the window), as do shadow rays to a point behind it; the
+/// oracle's values exactly (deterministic at `-ab 0 -ss 0`).
+#[test]
+fn oracle_bsdf_proxy_passes_view_and_shadow_rays() {
+    let Some(o) = common::oracle() else { return };
+    let dir = scratch("bsdf-material-proxy");
+    let (name, b) = files().remove(3);
+    std::fs::write(dir.join(name), klems_xml(&b, None).unwrap()).unwrap();
+    // a floor above the window, facing down: lit by the sun through the proxy
+    let scene = SCENE.replace("6 0 FILE", "6 0.01 FILE").replace("FILE", name)
+        + "void plastic grey\n0\n0\n5 .5 .5 .5 0 0\ngrey polygon ceiling\n0\n0\n12 -5 -5 3 -5 5 3 5 5 3 5 -5 3\n";
+    std::fs::write(dir.join("proxy.rad"), &scene).unwrap();
+    let mut c = o.command("oconv");
+    c.arg("proxy.rad").current_dir(&dir);
+    std::fs::write(dir.join("proxy.oct"), common::run_ok(&mut c)).unwrap();
+    let mut rays = views(1);
+    // the sky seen from below the window, and the ceiling seen from between (lit by the
+    // sun through the proxy at one point, shadowed by nothing else)
+    rays.push_str("0 1 -2 0 0 -1\n0.3 -0.2 -2.5 0 0 -1\n0 -1.5 1 0 0 1\n2 2 1 0 0 1\n");
+    let mut c = o.command("rtrace");
+    c.args(["-h", "-aa", "0", "-ab", "0", "-ss", "0", "proxy.oct"])
+        .current_dir(&dir);
+    let theirs = numbers(&run_stdin(c, rays.as_bytes()).stdout);
+    let mut c = fenestra("rtrace");
+    c.args(["-h", "-ab", "0", "-ss", "0", "proxy.rad"])
+        .current_dir(&dir);
+    c.env("RAYPATH", &dir);
+    let ours = numbers(&run_stdin(c, rays.as_bytes()).stdout);
+    assert_eq!(theirs.len(), ours.len());
+    assert!(
+        theirs.iter().filter(|v| **v > 0.0).count() >= 9,
+        "{theirs:?}"
+    );
+    for (k, (a, b)) in theirs.iter().zip(&ours).enumerate() {
+        assert!(
+            (a - b).abs() <= 1e-5 * a.abs() + 1e-9,
+            "value {k}: oracle {a} ours {b}"
+        );
+    }
+}

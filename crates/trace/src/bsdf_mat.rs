@@ -55,6 +55,9 @@ pub struct BsdfMat {
     pub td_back: DVec3,
     /// Tensor-tree data (the Klems components are then absent).
     pub tree: Option<Arc<TreeBsdf>>,
+    /// Thickness (first string argument): non-zero for a proxy of geometry modelled in
+    /// place, which view and shadow rays pass straight through.
+    pub thick: f64,
     /// The file's own Lambertian parts (hemispherical): reflection front, reflection back,
     /// transmission for a front view, transmission for a back view.
     pub lamb: [f64; 4],
@@ -282,9 +285,6 @@ pub fn compile(p: &Primitive) -> Result<BsdfMat> {
         })
     };
     let thick = num(0)?;
-    if thick != 0.0 {
-        bail!("{}: BSDF '{}': non-zero thickness (proxy geometry) is not supported by fenestra's ray tracer", p.loc, p.name);
-    }
     let up = DVec3::new(num(2)?, num(3)?, num(4)?);
     if up.length() == 0.0 {
         bail!("{}: BSDF '{}': zero up vector", p.loc, p.name);
@@ -329,6 +329,7 @@ pub fn compile(p: &Primitive) -> Result<BsdfMat> {
                 t.lambertian(Lobe::Transmission, false),
             ],
             tree: Some(Arc::new(t)),
+            thick,
         });
     }
     let get = |d: Direction, in_back: bool, out_back: bool| match b.klems(d, &vis) {
@@ -380,6 +381,7 @@ pub fn compile(p: &Primitive) -> Result<BsdfMat> {
         td_front: v3(6) + DVec3::splat(l_tf),
         td_back: v3(6) + DVec3::splat(l_tb),
         tree: None,
+        thick,
         lamb: [l_rf, l_rb, l_tf, l_tb],
     })
 }

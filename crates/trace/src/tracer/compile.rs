@@ -312,8 +312,9 @@ impl Tracer {
                 kind: LightKind::Illum(_),
                 ..
             } => true,
-            // clipped surfaces let shadow rays through
+            // clipped surfaces let shadow rays through, and so do BSDF proxies
             Material::Antimatter { .. } => true,
+            Material::Bsdf(b) => b.thick != 0.0,
             _ => false,
         });
         let occlusion_shadows = !passes_shadows && !opts.full;

@@ -15,6 +15,12 @@
 //!   the jitter; 0 turns it off), so a sun's beam is spread over a patch as in Radiance.
 //! - Ambient: the diffuse reflectance (plus unsampled reflection) on the view side, the
 //!   diffuse transmittance (plus unsampled transmission) on the other.
+//! - A thickness makes the surface a proxy for geometry modelled in place: shadow rays,
+//!   rays with no specular or ambient scattering in their history (view rays, mirror and
+//!   glass chains) and rays meeting its hidden side pass straight through; the other rays
+//!   are shaded, transmitted specular rays and transmitted direct light taken a thickness
+//!   behind the surface (along −normal), the far side's ambient a thickness in front (as
+//!   Radiance 6.0 does).
 
 use super::*;
 use crate::bsdf_mat::LobeData;
@@ -38,9 +44,18 @@ impl Tracer {
         cx: &mut Ctx,
     ) -> DVec3 {
         let (shape, p, n) = (s.shape, s.p, s.n);
-        if r.flags & SHADOW != 0 {
+        if b.thick != 0.0 {
+            let hidden = (b.thick > 0.0) != (s.rod > 0.0);
+            if r.flags & SHADOW != 0 || r.flags & (SPECULAR | AMBIENT) == 0 || hidden {
+                return self.pass(r.clone(), shape, p, s.t, cx);
+            }
+        } else if r.flags & SHADOW != 0 {
             return DVec3::ZERO;
         }
+        // a proxy's far side: transmitted rays and light a thickness behind, the far
+        // side's ambient a thickness in front
+        let behind = p - n * b.thick;
+        let before = p + n * b.thick;
         let z = n;
         let x =
             b.up.cross(z)
@@ -98,9 +113,14 @@ impl Tracer {
             }
             (sum / count as f64 - diff_y).max(0.0)
         };
+        // with a thickness, reflected and transmitted light are gathered at two points
+        let only = std::cell::Cell::new(None::<bool>);
         let lobe = |l: DVec3, omega: f64, ldot: f64| {
             let ll = to_local(l);
             let same = (ll.z > 0.0) == front;
+            if only.get().is_some_and(|want| want != same) {
+                return DVec3::ZERO;
+            }
             let (comp, diffuse, own) = if same {
                 (refl, rd, b.lamb[usize::from(!front)])
             } else {
@@ -113,10 +133,26 @@ impl Tracer {
         // with thresholding direct light comes last (as in Radiance), otherwise first
         let last = cx.ds.is_some();
         let lit = Lit::on(p, side, shape);
+        let direct = |cx: &mut Ctx, prior: DVec3| -> DVec3 {
+            if b.thick == 0.0 {
+                return self.direct(r, lit, prior, cx, &lobe);
+            }
+            only.set(Some(true));
+            let mut v = self.direct(r, lit, prior, cx, &lobe);
+            only.set(Some(false));
+            let far = Lit {
+                p: behind,
+                n: side,
+                shape: None,
+            };
+            v += self.direct(r, far, prior + v, cx, &lobe);
+            only.set(None);
+            v
+        };
         let mut val = if last {
             DVec3::ZERO
         } else {
-            self.direct(r, lit, DVec3::ZERO, cx, lobe)
+            direct(cx, DVec3::ZERO)
         };
         // the lobes: sampled with rays above -st, else folded into the diffuse parts
         let (mut rdiff, mut tdiff) = (rd, td);
@@ -154,7 +190,12 @@ impl Tracer {
                 if let Some((d, h)) = c.sample(vs, xr, u0, u1) {
                     let dir = (x * d.x + y * d.y + z * d.z).normalize();
                     let coef = DVec3::splat(h / nsamp as f64);
-                    val += self.spawn(r, s, dir, SPECULAR | flag, coef, cx);
+                    let from = if flag == TRANS && b.thick != 0.0 {
+                        Surf { p: behind, ..*s }
+                    } else {
+                        *s
+                    };
+                    val += self.spawn(r, &from, dir, SPECULAR | flag, coef, cx);
                 }
             }
         }
@@ -162,10 +203,11 @@ impl Tracer {
             val += self.ambient(r, p, side, rdiff, Some(shape), cx);
         }
         if maxc(tdiff) > FTINY {
-            val += self.ambient(r, p, -side, tdiff, Some(shape), cx);
+            let q = if b.thick != 0.0 { before } else { p };
+            val += self.ambient(r, q, -side, tdiff, Some(shape), cx);
         }
         if last {
-            val += self.direct(r, lit, val, cx, lobe);
+            val += direct(cx, val);
         }
         val
     }
