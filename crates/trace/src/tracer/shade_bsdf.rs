@@ -135,17 +135,17 @@ impl Tracer {
         let lit = Lit::on(p, side, shape);
         let direct = |cx: &mut Ctx, prior: DVec3| -> DVec3 {
             if b.thick == 0.0 {
-                return self.direct(r, lit, prior, cx, &lobe);
+                return self.direct(r, lit, prior, cx, lobe);
             }
             only.set(Some(true));
-            let mut v = self.direct(r, lit, prior, cx, &lobe);
+            let mut v = self.direct(r, lit, prior, cx, lobe);
             only.set(Some(false));
             let far = Lit {
                 p: behind,
                 n: side,
                 shape: None,
             };
-            v += self.direct(r, far, prior + v, cx, &lobe);
+            v += self.direct(r, far, prior + v, cx, lobe);
             only.set(None);
             v
         };
