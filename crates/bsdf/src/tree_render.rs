@@ -99,6 +99,15 @@ impl TreeBsdf {
             .any(|&k| self.comps[k].is_some())
     }
 
+    /// Projected solid angle of the smallest leaf of the tree `lobe` uses (Radiance's
+    /// `minProjSA`), 0 without one.
+    pub fn min_size(&self, lobe: Lobe, front: bool) -> f64 {
+        candidates(lobe, front)
+            .iter()
+            .find_map(|&k| self.comps[k].as_ref())
+            .map_or(0.0, |c| PI * c.finest * c.finest)
+    }
+
     /// BSDF value (sr⁻¹, Lambertian part removed) for view `v` and light `l`, and the
     /// projected solid angle of the leaf holding the pair.
     pub fn eval(&self, lobe: Lobe, front: bool, v: [f64; 3], l: [f64; 3]) -> (f64, f64) {

@@ -29,6 +29,8 @@ pub struct Component {
     in_back: bool,
     /// Largest directional-hemispherical total over incident patches.
     pub max_hemi: f64,
+    /// Projected solid angle of the smallest patch of the bases.
+    pub min_size: f64,
 }
 
 /// A compiled BSDF material.
@@ -58,6 +60,9 @@ pub struct BsdfMat {
     /// Thickness (first string argument): non-zero for a proxy of geometry modelled in
     /// place, which view and shadow rays pass straight through.
     pub thick: f64,
+    /// `aBSDF`: the transmission peak along the view is extracted and passed to view and
+    /// shadow rays as a straight-through component.
+    pub through: bool,
     /// The file's own Lambertian parts (hemispherical): reflection front, reflection back,
     /// transmission for a front view, transmission for a back view.
     pub lamb: [f64; 4],
@@ -132,6 +137,14 @@ impl LobeData<'_> {
         }
     }
 
+    /// Projected solid angle of the lobe's smallest cell (Radiance's `minProjSA`).
+    pub fn min_size(&self) -> f64 {
+        match self {
+            LobeData::Klems(c) => c.min_size,
+            LobeData::Tree(t, lobe, front) => t.min_size(*lobe, *front),
+        }
+    }
+
     /// BSDF value (sr⁻¹) for view `v` and light `l`.
     pub fn eval(&self, v: DVec3, l: DVec3) -> f64 {
         match self {
@@ -201,12 +214,17 @@ impl Component {
             .iter()
             .map(|c: &Vec<f64>| c.last().copied().unwrap_or(0.0))
             .fold(0.0, f64::max);
+        let min_size = (0..m.outgoing.len())
+            .filter_map(|o| m.outgoing.projected_solid_angle(o))
+            .chain((0..m.incident.len()).filter_map(|i| m.incident.projected_solid_angle(i)))
+            .fold(f64::INFINITY, f64::min);
         Component {
             m,
             cdf,
             out_back,
             in_back,
             max_hemi,
+            min_size,
         }
     }
 
@@ -266,38 +284,44 @@ impl Component {
 
 /// Compiles a `BSDF` primitive: `6 thick file ux uy uz funcfile`, 0/3/6/9 reals.
 pub fn compile(p: &Primitive) -> Result<BsdfMat> {
-    if p.sargs.len() < 6 {
+    // aBSDF has no thickness argument
+    let through = p.ptype == "aBSDF";
+    let o = usize::from(!through);
+    let kind = &p.ptype;
+    if p.sargs.len() < 5 + o {
         bail!(
-            "{}: BSDF '{}' needs 6 string arguments (thickness, file, up vector, function file)",
+            "{}: {kind} '{}' needs {} string arguments ({}file, up vector, function file)",
             p.loc,
-            p.name
+            p.name,
+            5 + o,
+            if through { "" } else { "thickness, " }
         );
     }
-    if p.sargs.len() > 6 {
-        bail!("{}: BSDF '{}': transforms after the function file are not supported by fenestra's ray tracer", p.loc, p.name);
+    if p.sargs.len() > 5 + o {
+        bail!("{}: {kind} '{}': transforms after the function file are not supported by fenestra's ray tracer", p.loc, p.name);
     }
     let num = |k: usize| -> Result<f64> {
         fenestra_scene::parse_real(&p.sargs[k]).with_context(|| {
             format!(
-                "{}: BSDF '{}': '{}' is not a number",
+                "{}: {kind} '{}': '{}' is not a number",
                 p.loc, p.name, p.sargs[k]
             )
         })
     };
-    let thick = num(0)?;
-    let up = DVec3::new(num(2)?, num(3)?, num(4)?);
+    let thick = if through { 0.0 } else { num(0)? };
+    let up = DVec3::new(num(1 + o)?, num(2 + o)?, num(3 + o)?);
     if up.length() == 0.0 {
-        bail!("{}: BSDF '{}': zero up vector", p.loc, p.name);
+        bail!("{}: {kind} '{}': zero up vector", p.loc, p.name);
     }
-    if p.sargs[5] != "." {
+    if p.sargs[4 + o] != "." {
         bail!(
-            "{}: BSDF '{}': function file '{}' is not supported (use '.')",
+            "{}: {kind} '{}': function file '{}' is not supported (use '.')",
             p.loc,
             p.name,
-            p.sargs[5]
+            p.sargs[4 + o]
         );
     }
-    let path = fenestra_cli::raypath::find_or_err(&p.sargs[1])
+    let path = fenestra_cli::raypath::find_or_err(&p.sargs[o])
         .with_context(|| format!("{}: BSDF '{}'", p.loc, p.name))?;
     let b = fenestra_bsdf::read_file(&path)
         .map_err(|e| anyhow::anyhow!("{}: BSDF '{}': {e}", p.loc, p.name))?;
@@ -330,6 +354,7 @@ pub fn compile(p: &Primitive) -> Result<BsdfMat> {
             ],
             tree: Some(Arc::new(t)),
             thick,
+            through,
         });
     }
     let get = |d: Direction, in_back: bool, out_back: bool| match b.klems(d, &vis) {
@@ -382,6 +407,7 @@ pub fn compile(p: &Primitive) -> Result<BsdfMat> {
         td_back: v3(6) + DVec3::splat(l_tb),
         tree: None,
         thick,
+        through,
         lamb: [l_rf, l_rb, l_tf, l_tb],
     })
 }

@@ -169,7 +169,7 @@ pub fn compile(scene: &Scene, i: usize) -> Result<Material> {
                 n: p.rargs[3],
             }
         }
-        "BSDF" => Material::Bsdf(Box::new(crate::bsdf_mat::compile(p)?)),
+        "BSDF" | "aBSDF" => Material::Bsdf(Box::new(crate::bsdf_mat::compile(p)?)),
         "light" => {
             need(p, 3)?;
             Material::Light {

@@ -314,7 +314,7 @@ impl Tracer {
             } => true,
             // clipped surfaces let shadow rays through, and so do BSDF proxies
             Material::Antimatter { .. } => true,
-            Material::Bsdf(b) => b.thick != 0.0,
+            Material::Bsdf(b) => b.thick != 0.0 || b.through,
             _ => false,
         });
         let occlusion_shadows = !passes_shadows && !opts.full;
@@ -358,9 +358,9 @@ impl Tracer {
             .prims
             .iter()
             .map(|p| match p.ptype.as_str() {
-                // (trans2, interface, mist and aBSDF would pass too, but the material
-                // compiler rejects them before this point)
-                "trans" | "dielectric" | "glass" => true,
+                // (trans2, interface and mist would pass too, but the material compiler
+                // rejects them before this point)
+                "trans" | "dielectric" | "glass" | "aBSDF" => true,
                 "BSDF" => p.sargs.first().is_some_and(|t| t != "0"),
                 _ => false,
             })

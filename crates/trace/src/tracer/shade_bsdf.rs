@@ -35,6 +35,91 @@ fn jitter(v: DVec3, radius: f64, u: f64, w: f64) -> DVec3 {
     j.try_normalize().unwrap_or(v)
 }
 
+/// aBSDF's through component for view `v` (Radiance's `compute_through`): the
+/// transmission evaluated along −v and 28 directions around it (up to 2.4 × √ of the
+/// smallest cell), sorted; leading values in cells no larger than 1.5 × the smallest, and
+/// not below an eighth of the mean of those before them, form the peak, the rest its
+/// surround. Returns the peak's transmittance (Σ value × cell) and the surround's mean
+/// BTDF, both without the Lambertian part `diff` (sr⁻¹); zeros where there is no peak
+/// (the strongest direction not in a peak cell, a surround under 0.2 of the peak's solid
+/// angle, a peak under 0.0005).
+fn through(trans: Option<&LobeData>, v: DVec3, diff: f64) -> (f64, f64) {
+    const OFFSETS: [(f64, f64); 29] = [
+        (0.0, 0.0),
+        (-0.6, 0.0),
+        (0.0, 0.6),
+        (0.0, -0.6),
+        (0.6, 0.0),
+        (-0.6, 0.6),
+        (-0.6, -0.6),
+        (0.6, 0.6),
+        (0.6, -0.6),
+        (-1.2, 0.0),
+        (0.0, 1.2),
+        (0.0, -1.2),
+        (1.2, 0.0),
+        (-1.2, 1.2),
+        (-1.2, -1.2),
+        (1.2, 1.2),
+        (1.2, -1.2),
+        (-1.8, 0.0),
+        (0.0, 1.8),
+        (0.0, -1.8),
+        (1.8, 0.0),
+        (-1.8, 1.8),
+        (-1.8, -1.8),
+        (1.8, 1.8),
+        (1.8, -1.8),
+        (-2.4, 0.0),
+        (0.0, 2.4),
+        (0.0, -2.4),
+        (2.4, 0.0),
+    ];
+    let Some(t) = trans else { return (0.0, 0.0) };
+    let min = t.min_size();
+    let rad = min.sqrt();
+    let mut samples: Vec<(f64, DVec3)> = OFFSETS
+        .iter()
+        .map(|&(dx, dy)| {
+            let d = DVec3::new(-v.x + dx * rad, -v.y + dy * rad, -v.z).normalize();
+            (t.eval(v, d) + diff, d)
+        })
+        .collect();
+    samples.sort_by(|a, b| b.0.total_cmp(&a.0));
+    if samples[0].0 <= FTINY {
+        return (0.0, 0.0);
+    }
+    let (mut peak, mut surr, mut ypeak, mut tsum, mut tsurr) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    let mut ns = 0.0;
+    for (i, &(y, d)) in samples.iter().enumerate() {
+        if i > 0 && y == samples[i - 1].0 {
+            continue; // a duplicate cell
+        }
+        let size = t.eval_sized(v, d).1;
+        if size > 1.5 * min || ypeak > 8.0 * y * ns {
+            if i == 0 {
+                return (0.0, 0.0);
+            }
+            surr += y * size;
+            tsurr += size;
+            continue;
+        }
+        peak += y * size;
+        tsum += size;
+        ypeak += y;
+        ns += 1.0;
+    }
+    if tsurr < 0.2 * tsum {
+        return (0.0, 0.0);
+    }
+    let surr = (surr / tsurr - diff).max(0.0);
+    let peak = (peak - tsum * diff).max(0.0);
+    if peak < 0.0005 {
+        return (0.0, 0.0);
+    }
+    (peak, surr)
+}
+
 impl Tracer {
     pub(super) fn shade_bsdf(
         &self,
@@ -49,7 +134,7 @@ impl Tracer {
             if r.flags & SHADOW != 0 || r.flags & (SPECULAR | AMBIENT) == 0 || hidden {
                 return self.pass(r.clone(), shape, p, s.t, cx);
             }
-        } else if r.flags & SHADOW != 0 {
+        } else if r.flags & SHADOW != 0 && !b.through {
             return DVec3::ZERO;
         }
         // a proxy's far side: transmitted rays and light a thickness behind, the far
@@ -72,6 +157,22 @@ impl Tracer {
             (b.rd_back, b.td_back)
         };
         let side = if front { z } else { -z };
+        // aBSDF: the transmission peak along the view passes straight on, for shadow rays
+        // and for rays with no specular or ambient scattering behind them
+        let (cthru, csurr) = if b.through {
+            through(trans.as_ref(), v, b.lamb[2 + usize::from(!front)] / PI)
+        } else {
+            (0.0, 0.0)
+        };
+        if r.flags & SHADOW != 0 {
+            return if cthru > FTINY {
+                self.spawn(r, s, r.dir, TRANS, DVec3::splat(cthru), cx)
+            } else {
+                DVec3::ZERO
+            };
+        }
+        let hasthru = cthru > FTINY && r.flags & (SPECULAR | AMBIENT) == 0;
+        let thru_min = trans.as_ref().map_or(0.0, |t| t.min_size());
         let (ss, st) = (self.opts.ss.max(0.0), self.opts.st);
         let shrink = if ss < 1.0 { ss } else { 1.0 };
         // direct light: jittered views drawn from a generator of this hit's own (the
@@ -121,6 +222,17 @@ impl Tracer {
             if only.get().is_some_and(|want| want != same) {
                 return DVec3::ZERO;
             }
+            // aBSDF: a source seen through the peak gets the surround's BTDF (the peak
+            // itself reaches the source by the through ray, not counted twice)
+            if cthru > FTINY && !same {
+                let (dx, dy) = (ll.x + v.x, ll.y + v.y);
+                let tw = omega * ll.z.abs();
+                if dx * dx + dy * dy
+                    <= (2.5 * 4.0 / PI) * (tw + thru_min + 2.0 * (tw * thru_min).sqrt())
+                {
+                    return (DVec3::splat(csurr) + td / PI) * (ldot.abs() * omega);
+                }
+            }
             let (comp, diffuse, own) = if same {
                 (refl, rd, b.lamb[usize::from(!front)])
             } else {
@@ -158,12 +270,18 @@ impl Tracer {
         let (mut rdiff, mut tdiff) = (rd, td);
         for (comp, flag) in [(refl, REFLECTED), (trans, TRANS)] {
             let Some(c) = comp else { continue };
-            if c.max_hemi() <= FTINY {
+            let thru = hasthru && flag == TRANS;
+            let mut taken = 0.0;
+            if thru {
+                val += self.spawn(r, s, r.dir, TRANS, DVec3::splat(cthru), cx);
+                taken = cthru;
+            }
+            if c.max_hemi() - taken <= FTINY {
                 continue;
             }
             let big = c.view_size(v).sqrt() * shrink;
             let (u, w) = (cx.rng.next_f64(), cx.rng.next_f64());
-            let total = c.hemi(jitter(v, big, u, w));
+            let total = (c.hemi(jitter(v, big, u, w)) - taken).max(0.0);
             if total <= st + FTINY {
                 if flag == REFLECTED {
                     rdiff += DVec3::splat(total);
@@ -188,6 +306,10 @@ impl Tracer {
                 let (ju, jw) = (cx.rng.next_f64(), cx.rng.next_f64());
                 let vs = jitter(v, small, ju, jw);
                 if let Some((d, h)) = c.sample(vs, xr, u0, u1) {
+                    // the through ray already carries the view's own direction
+                    if thru && (vs.x + d.x).powi(2) + (vs.y + d.y).powi(2) <= small * small {
+                        continue;
+                    }
                     let dir = (x * d.x + y * d.y + z * d.z).normalize();
                     let coef = DVec3::splat(h / nsamp as f64);
                     let from = if flag == TRANS && b.thick != 0.0 {
