@@ -34,8 +34,13 @@ struct Comp {
     finest: f64,
 }
 
-/// The leaves of one slice: (cumulative weight, lower corner in the free dimensions, edge).
-type Cells = Vec<(f64, [f64; 2], f64)>;
+/// The leaves of one slice: (cumulative weight, lower corner in the free dimensions, edge),
+/// and the projected solid angle of the smallest.
+#[derive(Debug, Default)]
+struct Cells {
+    leaves: Vec<(f64, [f64; 2], f64)>,
+    smallest: f64,
+}
 
 /// A slice's cache key: component, whether it is used in its own direction, incident cell.
 type SliceKey = (usize, bool, u32, u32);
@@ -137,7 +142,7 @@ impl TreeBsdf {
             Side::ExtRefl | Side::IntExt => -1.0,
         };
         let mut s = Slice {
-            cells: Arc::new(Vec::new()),
+            cells: Arc::new(Cells::default()),
             total: 0.0,
             rank: c.rank,
             theta: 0.0,
@@ -180,8 +185,9 @@ impl TreeBsdf {
             Some(cells) => cells,
             None => {
                 let free: Vec<usize> = (0..c.rank).filter(|i| mask >> i & 1 == 0).collect();
-                let mut cells: Cells = Vec::new();
+                let mut cells = Cells::default();
                 let mut total = 0.0;
+                let mut smallest = f64::INFINITY;
                 slice_leaves(
                     &c.root,
                     c.rank,
@@ -193,10 +199,14 @@ impl TreeBsdf {
                         let w = f64::from(val).max(0.0) * PI * edge * edge;
                         if w > 0.0 {
                             total += w;
-                            cells.push((total, [cmin[free[0]], cmin[free[1]]], edge));
+                            smallest = smallest.min(PI * edge * edge);
+                            cells
+                                .leaves
+                                .push((total, [cmin[free[0]], cmin[free[1]]], edge));
                         }
                     },
                 );
+                cells.smallest = if smallest.is_finite() { smallest } else { 0.0 };
                 let cells = Arc::new(cells);
                 if let Ok(mut m) = self.cache.lock() {
                     if m.len() < MAX_CACHED {
@@ -206,7 +216,7 @@ impl TreeBsdf {
                 cells
             }
         };
-        s.total = cells.last().map_or(0.0, |c| c.0);
+        s.total = cells.leaves.last().map_or(0.0, |c| c.0);
         s.cells = cells;
         Some(s)
     }
@@ -281,12 +291,7 @@ impl Slice {
 
     /// Projected solid angle of the smallest leaf of the slice (0 when empty).
     pub fn smallest(&self) -> f64 {
-        self.cells
-            .iter()
-            .map(|c| PI * c.2 * c.2)
-            .fold(f64::INFINITY, f64::min)
-            .min(PI)
-            * f64::from(u8::from(!self.cells.is_empty()))
+        self.cells.smallest
     }
 
     /// A direction drawn in proportion to value × projected solid angle: `x` picks the
@@ -296,11 +301,9 @@ impl Slice {
             return None;
         }
         let t = x * self.total;
-        let k = self
-            .cells
-            .partition_point(|c| c.0 <= t)
-            .min(self.cells.len() - 1);
-        let (_, lo, edge) = self.cells[k];
+        let leaves = &self.cells.leaves;
+        let k = leaves.partition_point(|c| c.0 <= t).min(leaves.len() - 1);
+        let (_, lo, edge) = leaves[k];
         let (sx, sy) = square_to_disk(lo[0] + u * edge, lo[1] + w * edge);
         let z = self.sign * (1.0 - sx * sx - sy * sy).max(0.0).sqrt();
         Some(match (self.rank, self.reverse) {
