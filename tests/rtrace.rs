@@ -361,3 +361,42 @@ fn reference_threephase_bsdf_overcast() {
     }
     assert!((sf / so - 1.0).abs() < 0.02, "mean ratio {}", sf / so);
 }
+
+/// `-defaults` prints the options in effect (those given before it) in Radiance's layout,
+/// `-version` names the program; a sky-only scene (a glow, no light source) runs without
+/// the no-light-sources warning, which stays for a scene where nothing emits.
+#[test]
+fn defaults_version_and_warnings_as_radiance() {
+    let dir = common::scratch("rtrace-defaults");
+    let out =
+        common::run_ok(common::fenestra("rtrace").args(["-ab", "3", "-ss", "0.5", "-defaults"]));
+    let text = String::from_utf8_lossy(&out);
+    assert!(text.contains("-ab 3 "), "{text}");
+    assert!(text.contains("-ss 0.500000"), "{text}");
+    assert!(text.lines().count() > 20);
+    let out = common::run_ok(common::fenestra("rtrace").arg("-version"));
+    assert!(String::from_utf8_lossy(&out).starts_with("fenestra "));
+    std::fs::write(
+        dir.join("sky.rad"),
+        "void glow g\n0\n0\n4 1 1 1 0\ng source s\n0\n0\n4 0 0 1 180\n",
+    )
+    .unwrap();
+    let mut c = common::fenestra("rtrace");
+    c.args(["-h", "sky.rad"]).current_dir(&dir);
+    let o = common::run_stdin(c, b"0 0 0 0 0 1\n");
+    assert!(o.status.success());
+    assert_eq!(
+        String::from_utf8_lossy(&o.stderr),
+        "",
+        "a sky-only scene warned"
+    );
+    std::fs::write(
+        dir.join("dark.rad"),
+        "void plastic m\n0\n0\n5 .5 .5 .5 0 0\nm sphere b\n0\n0\n4 0 0 5 1\n",
+    )
+    .unwrap();
+    let mut c = common::fenestra("rtrace");
+    c.args(["-h", "dark.rad"]).current_dir(&dir);
+    let o = common::run_stdin(c, b"0 0 0 0 0 1\n");
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no light sources found"));
+}

@@ -140,7 +140,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
 
     if picture {
         if !oc_given {
-            fenestra_cli::warn("changing output type to -oc");
+            fenestra_cli::warn("changing output type to -oc (a picture V gives pictures, written as RGBE; -oc says so)");
         }
         o.out_fmt = DataFormat::Rgbe;
         // Radiance writes picture headers whatever -h says.

@@ -347,8 +347,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         for w in tracer.warnings() {
             fenestra_cli::warn(w);
         }
-        if tracer.source_count() == 0 {
-            fenestra_cli::warn("no light sources found");
+        if !tracer.emits() {
+            fenestra_cli::warn("no light sources found (nothing in the scene emits light)");
         }
     }
     let mut tracked = Vec::new();

@@ -55,6 +55,72 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             files.extend(args[i..].iter().cloned());
             break;
         }
+        if a == "-version" {
+            println!(
+                "fenestra {} rtrace (Radiance 6.0a compatible)",
+                env!("CARGO_PKG_VERSION")
+            );
+            return Ok(ExitCode::SUCCESS);
+        }
+        if a == "-defaults" {
+            // Radiance's layout, with the values in effect (those given before it)
+            let pm = |b: bool| if b { '+' } else { '-' };
+            let fc = |f: Fmt| match f {
+                Fmt::Ascii => 'a',
+                Fmt::Float => 'f',
+                Fmt::Double => 'd',
+            };
+            let lines = [
+                format!(
+                    "-w{}\t\t\t\t# warning messages {}",
+                    pm(fenestra_cli::warnings_on()),
+                    if fenestra_cli::warnings_on() {
+                        "on"
+                    } else {
+                        "off"
+                    }
+                ),
+                format!("-n {nproc:<8}\t\t\t# number of rendering threads"),
+                format!("-x {xres:<8}\t\t\t# flush interval"),
+                format!("-y {yres:<8}\t\t\t# y resolution"),
+                format!("-h{}\t\t\t\t# output header", pm(header)),
+                format!("-f{}{}\t\t\t\t# format input/output", fc(fin), fc(fout)),
+                format!("-o{outspec:<8}\t\t\t# output value"),
+                format!("-I{}\t\t\t\t# irradiance at the input point", pm(irr)),
+                format!(
+                    "-i{}\t\t\t\t# irradiance calculation {}",
+                    pm(irr_hit),
+                    if irr_hit { "on" } else { "off" }
+                ),
+                format!(
+                    "-bv{}\t\t\t\t# back face visibility {}",
+                    pm(o.bv),
+                    if o.bv { "on" } else { "off" }
+                ),
+                format!("-dt {:.6}\t\t\t# direct threshold", o.dt),
+                format!("-dc {:.6}\t\t\t# direct certainty", o.dc),
+                format!("-dj {:.6}\t\t\t# direct jitter", o.dj),
+                format!("-ds {:.6}\t\t\t# direct sampling", o.ds),
+                format!("-dr {:<8}\t\t\t# direct relays", o.dr),
+                format!("-ss {:.6}\t\t\t# specular sampling", o.ss),
+                format!("-st {:.6}\t\t\t# specular threshold", o.st),
+                format!(
+                    "-av {:.6} {:.6} {:.6}\t# ambient value",
+                    o.av[0], o.av[1], o.av[2]
+                ),
+                format!("-ab {:<8}\t\t\t# ambient bounces", o.ab),
+                "-aa 0.000000\t\t\t# ambient accuracy (fenestra: no irradiance cache)".to_string(),
+                format!("-ad {:<8}\t\t\t# ambient divisions", o.ad),
+                format!("-as {:<8}\t\t\t# ambient super-samples", o.asamp),
+                format!("-lr {:<8}\t\t\t# limit reflection (Russian roulette)", o.lr),
+                format!("-lw {:.2e}\t\t\t# limit weight", o.lw),
+                format!("-seed {:<8}\t\t# random stream seed (fenestra)", o.seed),
+            ];
+            for l in lines {
+                println!("{l}");
+            }
+            return Ok(ExitCode::SUCCESS);
+        }
         if let Some(v) = toggle(a, "I", irr) {
             irr = v;
         } else if let Some(v) = toggle(a, "i", irr_hit) {
@@ -169,8 +235,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             );
         }
     }
-    if tracer.source_count() == 0 && !outspec.chars().all(|c| "odlLpnN".contains(c)) {
-        fenestra_cli::warn("no light sources found");
+    if !tracer.emits() && !outspec.chars().all(|c| "odlLpnN".contains(c)) {
+        fenestra_cli::warn("no light sources found (nothing in the scene emits light)");
     }
     let expect = if yres > 0 { xres.max(1) * yres } else { 0 };
     let out = std::io::stdout();

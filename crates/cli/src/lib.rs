@@ -15,4 +15,6 @@ pub mod rays;
 mod run;
 pub mod threads;
 
-pub use run::{command_line, main_with, main_with_args, prog, set_prog, set_warnings, warn, Exit};
+pub use run::{
+    command_line, main_with, main_with_args, prog, set_prog, set_warnings, warn, warnings_on, Exit,
+};

@@ -6,6 +6,11 @@ use std::sync::OnceLock;
 static PROG: OnceLock<String> = OnceLock::new();
 static WARNINGS: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(true);
 
+/// Whether warnings are printed.
+pub fn warnings_on() -> bool {
+    WARNINGS.load(std::sync::atomic::Ordering::Relaxed)
+}
+
 /// Turns warnings on or off (Radiance's `-w`).
 pub fn set_warnings(on: bool) {
     WARNINGS.store(on, std::sync::atomic::Ordering::Relaxed);

@@ -295,6 +295,14 @@ impl Tracer {
         self.sources.len()
     }
 
+    /// Whether anything in the scene emits light (a light source, or a glow such as a sky):
+    /// without it every value is zero, the case worth a warning.
+    pub fn emits(&self) -> bool {
+        self.mats
+            .values()
+            .any(|m| matches!(m, Material::Light { .. }))
+    }
+
     fn tmin(p: DVec3) -> f64 {
         1e-9 * (1.0 + p.abs().max_element())
     }
