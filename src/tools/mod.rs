@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 pub mod checkbsdf;
 pub mod dctimestep;
+pub mod genbsdf;
 pub mod gendaylit;
 pub mod gendaymtx;
 pub mod genklemsamp;
@@ -30,6 +31,7 @@ pub fn registry() -> &'static [(&'static str, Run)] {
     &[
         ("checkBSDF", checkbsdf::run),
         ("dctimestep", dctimestep::run),
+        ("genBSDF", genbsdf::run),
         ("gendaylit", gendaylit::run),
         ("gendaymtx", gendaymtx::run),
         ("genklemsamp", genklemsamp::run),

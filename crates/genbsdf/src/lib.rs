@@ -1,0 +1,262 @@
+//! genBSDF's Klems characterisation in one process: a device's geometry traced with the
+//! library's tracer from a stratified sample plane, every Klems incident direction in
+//! turn, what leaves toward either hemisphere binned by Klems patch, as Radiance's genBSDF
+//! gets it from rfluxmtx (facts from its `genBSDF.pl` and `wrapBSDF.c`; our own code).
+//!
+//! Geometry frame (genBSDF's): X = width, Y = up, +Z into the room; the device lies at
+//! Z ≤ 0. Backward components (light from the room side, +Z) are `Transmission Back` and
+//! `Reflection Back`; forward ones (light from outside) `Transmission Front` and
+//! `Reflection Front` (WINDOW 6 naming, as wrapBSDF writes them). The element at row o,
+//! column i is the flux leaving through patch o for light arriving within patch i, per
+//! unit incident flux, divided by patch o's projected solid angle: the BSDF in sr⁻¹.
+//! Patch indices use Radiance's mapping of directions to the XML's bases (the one the
+//! `BSDF` material reads back): the incident direction (toward the source) mirrored in
+//! x and y, each side's hemisphere folded onto +Z.
+
+use anyhow::{bail, Result};
+use fenestra_bsdf::{Block, BlockData, Bsdf, DataStructure, Direction, KlemsBasis, KlemsMatrix};
+use fenestra_scene::Scene;
+use fenestra_trace::{DVec3, TraceOptions, Tracer};
+use rayon::prelude::*;
+
+/// Luminance weights of Radiance's `rmtxop -c y` (no 179 factor), as genBSDF applies them.
+const Y_WEIGHTS: [f64; 3] = [0.265_105_81, 0.670_105_81, 0.064_788_356];
+
+/// What to characterise and how.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// Samples per incident direction asked for (`-c`; the sample plane's grid rounds it).
+    pub samples: usize,
+    /// Light from outside (`+f`): `Transmission Front`, `Reflection Front`.
+    pub forward: bool,
+    /// Light from the room (`+b`): `Transmission Back`, `Reflection Back`.
+    pub backward: bool,
+    /// The bounding box `x0 x1 y0 y1 z0 z1` (`-dim`), else the geometry's.
+    pub dim: Option<[f64; 6]>,
+    /// Render options (genBSDF's `-ab 5 -ad 700 -lw 3e-6` over rcontrib's defaults).
+    pub trace: TraceOptions,
+}
+
+impl Options {
+    /// genBSDF's defaults: `-c 2000`, backward only, `-ab 5 -ad 700 -lw 3e-6`.
+    pub fn genbsdf() -> Options {
+        let mut trace = TraceOptions::rcontrib();
+        trace.ab = 5;
+        trace.ad = 700;
+        trace.lw = 3e-6;
+        Options {
+            samples: 2000,
+            forward: false,
+            backward: true,
+            dim: None,
+            trace,
+        }
+    }
+}
+
+/// The sample grid genBSDF uses for `n` samples over a `w` × `h` rectangle:
+/// nx = ⌊√(n·w/h) + 1⌋, ny = ⌊n/nx + 1⌋.
+pub fn grid(n: usize, w: f64, h: f64) -> (usize, usize) {
+    let nx = ((n as f64 * w / h).sqrt() + 1.0).floor().max(1.0) as usize;
+    let ny = (n as f64 / nx as f64 + 1.0).floor().max(1.0) as usize;
+    (nx, ny)
+}
+
+/// The bounding box of a scene's surfaces: `[x0, x1, y0, y1, z0, z1]`.
+pub fn bounding_box(scene: &Scene) -> Result<[f64; 6]> {
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for p in &scene.prims {
+        if p.modifier.is_none() || !fenestra_trace::surface::is_geometry(&p.ptype) {
+            continue;
+        }
+        if let fenestra_trace::surface::Built::Shape(s, _) = fenestra_trace::surface::shape_of(p)? {
+            let (a, b) = s.bounds();
+            lo = lo.min(a);
+            hi = hi.max(b);
+        }
+    }
+    if !lo.is_finite() || !hi.is_finite() {
+        bail!("the device has no surfaces");
+    }
+    Ok([lo.x, hi.x, lo.y, hi.y, lo.z, hi.z])
+}
+
+/// The receivers: glows at infinity on the room side and behind, named so the device
+/// cannot use the names.
+const RECEIVERS: &str = "\
+void glow genbsdf_receiver_face\n0\n0\n4 1 1 1 0\n\
+genbsdf_receiver_face source genbsdf_face\n0\n0\n4 0 0 1 180\n\
+void glow genbsdf_receiver_behind\n0\n0\n4 1 1 1 0\n\
+genbsdf_receiver_behind source genbsdf_behind\n0\n0\n4 0 0 -1 180\n";
+
+/// What a run measured: the bounding box used and the BSDF.
+pub struct Characterised {
+    /// `[x0, x1, y0, y1, z0, z1]`.
+    pub dim: [f64; 6],
+    /// Samples actually traced per incident direction.
+    pub samples: usize,
+    /// Warnings (as Radiance's genBSDF prints them).
+    pub warnings: Vec<String>,
+    /// The BSDF (Klems full basis, visible).
+    pub bsdf: Bsdf,
+}
+
+/// Characterises the device `scene` (genBSDF's frame) on the Klems full basis.
+pub fn characterise(
+    scene: &Scene,
+    opts: &Options,
+    pool: &rayon::ThreadPool,
+) -> Result<Characterised> {
+    if !opts.forward && !opts.backward {
+        bail!("nothing to do: neither +forward nor +backward");
+    }
+    let dim = match opts.dim {
+        Some(d) => d,
+        None => bounding_box(scene)?,
+    };
+    let [x0, x1, y0, y1, z0, z1] = dim;
+    let (w, h) = (x1 - x0, y1 - y0);
+    if !(w > 0.0 && h > 0.0) {
+        bail!("the device's bounding box is empty ({w} x {h})");
+    }
+    if z0 >= 0.0 {
+        bail!("Device entirely inside room!");
+    }
+    let mut warnings = Vec::new();
+    if z1 > 1e-5 {
+        warnings.push("Device extends into room".to_string());
+    }
+    if z1 * z1 > 0.01 * w * h {
+        warnings.push("Device far behind Z==0 plane".to_string());
+    }
+    // the device with the two receivers
+    let mut parser = fenestra_scene::Parser::new();
+    parser.add_scene(scene.clone())?;
+    parser.add_str(RECEIVERS, "genBSDF receivers")?;
+    let full = parser.finish();
+    let tracer = Tracer::new(&full, &opts.trace)?;
+    let find = |name: &str| full.prims.iter().position(|p| p.name == name);
+    let (Some(face), Some(behind)) = (
+        find("genbsdf_receiver_face"),
+        find("genbsdf_receiver_behind"),
+    ) else {
+        bail!("internal: receivers missing");
+    };
+    let mut tracked = vec![false; full.prims.len()];
+    tracked[face] = true;
+    tracked[behind] = true;
+    let (nx, ny) = grid(opts.samples.max(1), w, h);
+    let n = nx * ny;
+    let basis = KlemsBasis::full();
+    let np = basis.len();
+    let omega: Vec<f64> = (0..np)
+        .map(|o| basis.projected_solid_angle(o).unwrap_or(0.0))
+        .collect();
+    let mut blocks = Vec::new();
+    // (light from the room?, transmission direction, reflection direction)
+    let mut sides = Vec::new();
+    if opts.backward {
+        sides.push((true, Direction::TransmissionBack, Direction::ReflectionBack));
+    }
+    if opts.forward {
+        sides.push((
+            false,
+            Direction::TransmissionFront,
+            Direction::ReflectionFront,
+        ));
+    }
+    for (side_k, &(from_room, tdir, rdir)) in sides.iter().enumerate() {
+        let z = if from_room { z1 + 1e-5 } else { z0 - 1e-5 };
+        // per incident patch: flux fractions toward the far and near receivers, by patch
+        let rows: Vec<(Vec<f64>, Vec<f64>)> = pool.install(|| {
+            (0..np)
+                .into_par_iter()
+                .map(|i| {
+                    let (mut far, mut near) = (vec![0.0; np], vec![0.0; np]);
+                    for k in 0..n {
+                        let index = ((side_k * np + i) * n + k) as u64;
+                        let mut rng = fenestra_trace::rng::Rng::for_ray(0x6e6e_b5df, index);
+                        let (ix, iy) = (k % nx, k / nx);
+                        let px = x0 + w * (ix as f64 + rng.next_f64()) / nx as f64;
+                        let py = y0 + h * (iy as f64 + rng.next_f64()) / ny as f64;
+                        let (u0, u1) = (rng.next_f64(), rng.next_f64());
+                        let Some(b) = basis.sample_projected(i, u0, u1) else {
+                            continue;
+                        };
+                        // the incident direction (toward the source) is b mirrored in x
+                        // and y, on the source's side; rays travel the other way
+                        let dir = if from_room {
+                            DVec3::new(b[0], b[1], -b[2])
+                        } else {
+                            DVec3::new(b[0], b[1], b[2])
+                        };
+                        let org = DVec3::new(px, py, z);
+                        tracer.contributions(index, org, dir, &tracked, &mut |c| {
+                            let y: f64 = c.coef.iter().zip(Y_WEIGHTS).map(|(a, w)| a * w).sum();
+                            let d = c.dir;
+                            // the outgoing direction folded onto +Z
+                            let o = basis.patch([d.x, d.y, d.z.abs()]);
+                            let Some(o) = o else { return };
+                            let goes_to_room = d.z > 0.0;
+                            if goes_to_room != from_room {
+                                far[o] += y;
+                            } else {
+                                near[o] += y;
+                            }
+                        });
+                    }
+                    (far, near)
+                })
+                .collect()
+        });
+        let matrix = |far_side: bool| {
+            let mut values = vec![0.0; np * np];
+            for (i, row) in rows.iter().enumerate() {
+                let fractions = if far_side { &row.0 } else { &row.1 };
+                for (o, f) in fractions.iter().enumerate() {
+                    if omega[o] > 0.0 {
+                        values[o * np + i] = f / n as f64 / omega[o];
+                    }
+                }
+            }
+            KlemsMatrix {
+                incident: basis.clone(),
+                outgoing: basis.clone(),
+                values,
+            }
+        };
+        for (dir, m) in [(tdir, matrix(true)), (rdir, matrix(false))] {
+            blocks.push(Block {
+                wavelength: fenestra_bsdf::Wavelength::Visible,
+                direction: dir,
+                data_type: "BTDF".into(),
+                data: BlockData::Klems(m),
+            });
+        }
+    }
+    let bsdf = Bsdf {
+        name: "Unnamed".into(),
+        width: Some(w),
+        height: Some(h),
+        thickness: Some(-z0),
+        structure: Some(DataStructure::Columns),
+        bases: vec![basis.clone()],
+        blocks,
+        ..Default::default()
+    };
+    Ok(Characterised {
+        dim,
+        samples: n,
+        warnings,
+        bsdf,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn grid_as_genbsdf() {
+        assert_eq!(super::grid(2000, 1.0, 1.0), (45, 45));
+        assert_eq!(super::grid(1000, 0.3, 0.28856), (33, 31));
+    }
+}

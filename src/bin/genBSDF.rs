@@ -1,0 +1,3 @@
+fn main() -> std::process::ExitCode {
+    fenestra_cli::main_with(fenestra::tools::genbsdf::run)
+}

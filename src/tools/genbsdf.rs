@@ -1,0 +1,168 @@
+//! genBSDF: a device's BSDF from its geometry (Klems full basis), in one process over the
+//! library's tracer (fenestra-genbsdf). Command line as Radiance's genBSDF.
+
+use std::io::Write;
+use std::process::ExitCode;
+
+use anyhow::{bail, Context, Result};
+use fenestra_genbsdf::{characterise, Options};
+
+const USAGE: &str = "[-c Nsamp][-n Nproc][-r 'render opts'][{+|-}f[orward]][{+|-}b[ackward]][{+|-}mgf][{+|-}geom unit][-dim x0 x1 y0 y1 z0 z1] [input ..]";
+
+/// Geometry units genBSDF accepts, with their length in metres.
+const UNITS: [(&str, f64); 5] = [
+    ("meter", 1.0),
+    ("foot", 0.3048),
+    ("inch", 0.0254),
+    ("centimeter", 0.01),
+    ("millimeter", 0.001),
+];
+
+/// Runs genBSDF.
+pub fn run(args: Vec<String>) -> Result<ExitCode> {
+    if args.iter().skip(1).any(|a| a == "--help") {
+        println!(
+            "{} {USAGE}\nCharacterises the device geometry (X = width, Y = up, +Z into the room, device at Z <= 0) as a Klems BSDF (XML on standard output).",
+            fenestra_cli::prog()
+        );
+        return Ok(ExitCode::SUCCESS);
+    }
+    let mut o = Options::genbsdf();
+    let mut nproc = 1usize;
+    let mut mgf = false;
+    let mut unit = 1.0;
+    let mut render: Vec<String> = Vec::new();
+    let mut files: Vec<String> = Vec::new();
+    let mut i = 1;
+    let value = |i: usize| -> Result<&String> {
+        args.get(i)
+            .with_context(|| format!("option {} needs a value", args[i - 1]))
+    };
+    let number = |i: usize| -> Result<f64> {
+        let w = value(i)?;
+        fenestra_cli::opts::parse_real(w)
+            .with_context(|| format!("option {}: '{w}' is not a number", args[i - 1]))
+    };
+    while i < args.len() {
+        let a = args[i].as_str();
+        let plus = a.starts_with('+');
+        match a {
+            "-c" => {
+                let n = number(i + 1)?;
+                if !(n >= 1.0) {
+                    bail!("-c {n}: the number of samples must be at least 1");
+                }
+                o.samples = n as usize;
+                i += 1;
+            }
+            "-n" => {
+                nproc = fenestra_cli::threads::worker_count(number(i + 1)?)?;
+                i += 1;
+            }
+            "-r" => {
+                render.extend(fenestra_cli::expand::split_words(value(i + 1)?)?);
+                i += 1;
+            }
+            "+f" | "-f" | "+forward" | "-forward" => o.forward = plus,
+            "+b" | "-b" | "+backward" | "-backward" => o.backward = plus,
+            "+mgf" | "-mgf" => mgf = plus,
+            "+geom" | "-geom" => {
+                let u = value(i + 1)?;
+                unit = UNITS
+                    .iter()
+                    .find(|(n, _)| n.eq_ignore_ascii_case(u))
+                    .map(|(_, m)| *m)
+                    .with_context(|| format!("Illegal geometry unit '{u}' (meter, foot, inch, centimeter or millimeter)"))?;
+                i += 1;
+            }
+            "-dim" => {
+                let mut d = [0.0; 6];
+                for (k, v) in d.iter_mut().enumerate() {
+                    *v = number(i + 1 + k)?;
+                }
+                o.dim = Some(d);
+                i += 6;
+            }
+            "+C" | "-C" => {
+                if plus {
+                    bail!("+C (colour blocks) is not supported by fenestra's genBSDF yet (grey Y data only)");
+                }
+            }
+            "-t3" | "-t4" => bail!(
+                "{a}: tensor-tree output is not supported by fenestra's genBSDF yet (Klems only)"
+            ),
+            "-recover" => bail!(
+                "-recover: fenestra's genBSDF runs in one process and keeps no temporary directory"
+            ),
+            "-W" => {}
+            "-s" => i += 1,
+            _ if a.starts_with('-') && a.len() > 1 || plus => {
+                bail!(
+                    "unknown option '{a}'\nusage: {} {USAGE}",
+                    fenestra_cli::prog()
+                )
+            }
+            _ => files.push(a.to_string()),
+        }
+        i += 1;
+    }
+    // render options after genBSDF's own (later ones win)
+    let mut k = 0;
+    while k < render.len() {
+        let name = render[k].trim_start_matches('-').to_string();
+        if fenestra_trace::TraceOptions::is_number_option(&name) {
+            let v = render
+                .get(k + 1)
+                .and_then(|w| fenestra_cli::opts::parse_real(w))
+                .with_context(|| format!("-r: option -{name} needs a number"))?;
+            o.trace.set_number(&name, v);
+            k += 2;
+        } else {
+            bail!(
+                "-r: option '{}' is not supported by fenestra's genBSDF",
+                render[k]
+            );
+        }
+    }
+    if files.is_empty() {
+        files.push("-".into());
+    }
+    let mut parser = fenestra_scene::Parser::new();
+    for f in &files {
+        if mgf && f != "-" {
+            let text = std::fs::read(f).with_context(|| format!("cannot open '{f}'"))?;
+            parser.add_mgf(&fenestra_scene::decode_text(text), f)?;
+        } else {
+            parser.add_path(f)?;
+        }
+    }
+    let scene = parser.finish();
+    if !scene
+        .prims
+        .iter()
+        .any(|p| p.modifier.is_some() && fenestra_trace::surface::is_geometry(&p.ptype))
+    {
+        bail!("no device geometry in the input");
+    }
+    let pool = fenestra_cli::threads::pool(nproc)?;
+    let got = characterise(&scene, &o, &pool)?;
+    for w in &got.warnings {
+        fenestra_cli::warn(w);
+    }
+    let mut bsdf = got.bsdf;
+    // sizes in the chosen unit's metres
+    bsdf.width = bsdf.width.map(|v| v * unit);
+    bsdf.height = bsdf.height.map(|v| v * unit);
+    bsdf.thickness = bsdf.thickness.map(|v| v * unit);
+    let comment = format!(
+        "Created by: fenestra genBSDF {} ({} samples per direction)",
+        fenestra_cli::command_line(&args),
+        got.samples
+    );
+    let xml = fenestra_bsdf::write::klems_xml(&bsdf, Some(&comment))
+        .map_err(|e| anyhow::anyhow!("{e}"))?;
+    let mut out = std::io::stdout().lock();
+    out.write_all(xml.as_bytes())?;
+    out.flush()?;
+    Ok(ExitCode::SUCCESS)
+}
