@@ -49,7 +49,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         match a {
             "-c" => {
                 let n = number(i + 1)?;
-                if !(n >= 1.0) {
+                if n.is_nan() || n < 1.0 {
                     bail!("-c {n}: the number of samples must be at least 1");
                 }
                 o.samples = n as usize;
