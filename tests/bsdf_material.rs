@@ -286,12 +286,7 @@ fn oracle_bsdf_proxy_passes_view_and_shadow_rays() {
         theirs.iter().filter(|v| **v > 0.0).count() >= 9,
         "{theirs:?}"
     );
-    for (k, (a, b)) in theirs.iter().zip(&ours).enumerate() {
-        assert!(
-            (a - b).abs() <= 1e-5 * a.abs() + 1e-9,
-            "value {k}: oracle {a} ours {b}"
-        );
-    }
+    common::agree("proxy values", &theirs, &ours, 1e-5, 1e-9);
 }
 
 /// `aBSDF`: the transmission peak along the view is passed to view rays and shadow rays as

@@ -189,12 +189,7 @@ fn oracle_tree_direct_exact() {
     let (t, u) = (lum(&theirs), lum(&ours));
     let lit = t.iter().filter(|x| **x > 0.0).count();
     assert!(lit > 40, "{lit} lit views");
-    for (k, (a, b)) in t.iter().zip(&u).enumerate() {
-        assert!(
-            (a - b).abs() <= 1e-4 * a.abs() + 1e-6,
-            "view {k}: oracle {a} ours {b}"
-        );
-    }
+    common::agree("views", &t, &u, 1e-4, 1e-6);
 }
 
 /// A room of our own (issue 17): a west window with the reference blind turned 30° about
