@@ -45,13 +45,8 @@ fn reference_blind_matches_radiance_genbsdf() {
     assert!((ours.height.unwrap() - theirs.height.unwrap()).abs() < 1e-4);
 }
 
-/// An empty frame lets every ray through the opening straight on: each incident patch
-/// sends its light to one outgoing patch (the matrix is diagonal under Radiance's index
-/// mapping) and nothing is reflected; what misses the opening hits the frame (black).
-#[test]
-fn empty_frame_transmits_straight_through() {
-    let dir = scratch("genbsdf-frame");
-    // a 1 x 1 m black frame, 5 cm wide, 1 cm deep, at Z in [-0.01, 0]
+/// A 1 x 1 m black frame, 5 cm wide, 1 cm deep, at Z in [-0.01, 0] (a 0.9 m opening).
+fn frame_scene() -> String {
     let mut s = String::from("void plastic black\n0\n0\n5 0 0 0 0 0\n");
     for (k, (x0, x1, y0, y1)) in [
         (0.0, 1.0, 0.0, 0.05),
@@ -67,7 +62,16 @@ fn empty_frame_transmits_straight_through() {
         ));
     }
     s.push_str("black polygon back\n0\n0\n12 0 0 -0.01 1 0 -0.01 1 0.05 -0.01 0 0.05 -0.01\n");
-    std::fs::write(dir.join("frame.rad"), s).unwrap();
+    s
+}
+
+/// An empty frame lets every ray through the opening straight on: each incident patch
+/// sends its light to one outgoing patch (the matrix is diagonal under Radiance's index
+/// mapping) and nothing is reflected; what misses the opening hits the frame (black).
+#[test]
+fn empty_frame_transmits_straight_through() {
+    let dir = scratch("genbsdf-frame");
+    std::fs::write(dir.join("frame.rad"), frame_scene()).unwrap();
     let mut c = fenestra("genBSDF");
     c.args(["-c", "200", "+f", "+b", "frame.rad"])
         .current_dir(&dir);
@@ -162,4 +166,43 @@ fn bad_input_is_one_clear_error() {
         let e = String::from_utf8_lossy(&out.stderr);
         assert!(e.contains(want), "{args:?}: {e}");
     }
+}
+
+/// The summary on standard error (hemispherical totals per side, largest T+R, transmission
+/// reciprocity) is what checkBSDF's library computes from the XML written; `-q` silences it.
+#[test]
+fn summary_matches_the_file_and_q_silences_it() {
+    let dir = scratch("genbsdf-summary");
+    std::fs::write(dir.join("frame.rad"), frame_scene()).unwrap();
+    let mut c = fenestra("genBSDF");
+    c.args(["-c", "30", "+f", "+b", "frame.rad"])
+        .current_dir(&dir);
+    let out = c.output().unwrap();
+    assert!(out.status.success());
+    std::fs::write(dir.join("frame.xml"), &out.stdout).unwrap();
+    let b = read_file(&dir.join("frame.xml")).unwrap();
+    let err = String::from_utf8(out.stderr).unwrap();
+    let t = diffuse_total(&b, Direction::TransmissionBack);
+    let want = "light from the room (Back): T normal ";
+    let line = err
+        .lines()
+        .find(|l| l.starts_with(want))
+        .unwrap_or_else(|| panic!("no summary in {err:?}"));
+    assert!(line.contains(&format!("diffuse {t:.4}")), "{line} vs {t}");
+    assert!(err.contains("light from outside (Front): "), "{err}");
+    assert!(err.contains("transmission reciprocity"), "{err}");
+    let mut c = fenestra("genBSDF");
+    c.args(["-q", "-c", "30", "+f", "+b", "frame.rad"])
+        .current_dir(&dir);
+    let out = c.output().unwrap();
+    assert!(out.status.success());
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // the same data (only the command line in the comment differs)
+    std::fs::write(dir.join("quiet.xml"), &out.stdout).unwrap();
+    let q = read_file(&dir.join("quiet.xml")).unwrap();
+    assert_eq!(diffuse_total(&q, Direction::TransmissionBack), t);
 }

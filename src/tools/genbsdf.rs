@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use fenestra_genbsdf::{characterise, Options};
 
-const USAGE: &str = "[-c Nsamp][-n Nproc][-r 'render opts'][{+|-}f[orward]][{+|-}b[ackward]][{+|-}mgf][{+|-}geom unit][-dim x0 x1 y0 y1 z0 z1] [input ..]";
+const USAGE: &str = "[-q][-c Nsamp][-n Nproc][-r 'render opts'][{+|-}f[orward]][{+|-}b[ackward]][{+|-}mgf][{+|-}geom unit][-dim x0 x1 y0 y1 z0 z1] [input ..]";
 
 /// Geometry units genBSDF accepts, with their length in metres.
 const UNITS: [(&str, f64); 5] = [
@@ -30,6 +30,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let mut o = Options::genbsdf();
     let mut nproc = 1usize;
     let mut mgf = false;
+    let mut quiet = false;
     let mut unit = 1.0;
     let mut render: Vec<String> = Vec::new();
     let mut files: Vec<String> = Vec::new();
@@ -95,6 +96,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 "-recover: fenestra's genBSDF runs in one process and keeps no temporary directory"
             ),
             "-W" => {}
+            "-q" => quiet = true,
             "-s" => i += 1,
             _ if a.starts_with('-') && a.len() > 1 || plus => {
                 bail!(
@@ -164,5 +166,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let mut out = std::io::stdout().lock();
     out.write_all(xml.as_bytes())?;
     out.flush()?;
+    if !quiet {
+        eprint!("{}", fenestra_genbsdf::summary(&bsdf));
+    }
     Ok(ExitCode::SUCCESS)
 }

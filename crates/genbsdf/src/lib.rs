@@ -13,6 +13,9 @@
 //! `BSDF` material reads back): the incident direction (toward the source) mirrored in
 //! x and y, each side's hemisphere folded onto +Z.
 
+mod summary;
+pub use summary::summary;
+
 use anyhow::{bail, Result};
 use fenestra_bsdf::{Block, BlockData, Bsdf, DataStructure, Direction, KlemsBasis, KlemsMatrix};
 use fenestra_scene::Scene;
