@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use fenestra_genbsdf::{characterise, Options};
 
-const USAGE: &str = "[-q][-c Nsamp][-n Nproc][-r 'render opts'][{+|-}f[orward]][{+|-}b[ackward]][{+|-}mgf][{+|-}geom unit][-dim x0 x1 y0 y1 z0 z1] [input ..]";
+const USAGE: &str = "[-q][-E errors.xml][-c Nsamp][-n Nproc][-r 'render opts'][{+|-}f[orward]][{+|-}b[ackward]][{+|-}mgf][{+|-}geom unit][-dim x0 x1 y0 y1 z0 z1] [input ..]";
 
 /// Geometry units genBSDF accepts, with their length in metres.
 const UNITS: [(&str, f64); 5] = [
@@ -31,6 +31,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let mut nproc = 1usize;
     let mut mgf = false;
     let mut quiet = false;
+    let mut error_file: Option<String> = None;
     let mut unit = 1.0;
     let mut render: Vec<String> = Vec::new();
     let mut files: Vec<String> = Vec::new();
@@ -97,6 +98,11 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             ),
             "-W" => {}
             "-q" => quiet = true,
+            "-E" => {
+                error_file = Some(value(i + 1)?.clone());
+                o.errors = true;
+                i += 1;
+            }
             "-s" => i += 1,
             _ if a.starts_with('-') && a.len() > 1 || plus => {
                 bail!(
@@ -151,11 +157,14 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     for w in &got.warnings {
         fenestra_cli::warn(w);
     }
-    let mut bsdf = got.bsdf;
     // sizes in the chosen unit's metres
-    bsdf.width = bsdf.width.map(|v| v * unit);
-    bsdf.height = bsdf.height.map(|v| v * unit);
-    bsdf.thickness = bsdf.thickness.map(|v| v * unit);
+    let in_metres = |mut b: fenestra_bsdf::Bsdf| {
+        b.width = b.width.map(|v| v * unit);
+        b.height = b.height.map(|v| v * unit);
+        b.thickness = b.thickness.map(|v| v * unit);
+        b
+    };
+    let bsdf = in_metres(got.bsdf);
     let comment = format!(
         "Created by: fenestra genBSDF {} ({} samples per direction)",
         fenestra_cli::command_line(&args),
@@ -163,6 +172,19 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     );
     let xml = fenestra_bsdf::write::klems_xml(&bsdf, Some(&comment))
         .map_err(|e| anyhow::anyhow!("{e}"))?;
+    if let (Some(path), Some(errors)) = (&error_file, got.errors) {
+        let text = fenestra_bsdf::write::klems_xml(
+            &in_metres(errors),
+            Some(&format!(
+                "{comment}: standard error of each element (sr^-1)"
+            )),
+        )
+        .map_err(|e| anyhow::anyhow!("{e}"))?;
+        let mut f = fenestra_cli::output::AtomicFile::create(path)
+            .with_context(|| format!("cannot write '{path}'"))?;
+        f.write_all(text.as_bytes())?;
+        f.commit()?;
+    }
     let mut out = std::io::stdout().lock();
     out.write_all(xml.as_bytes())?;
     out.flush()?;

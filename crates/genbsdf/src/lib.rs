@@ -38,6 +38,8 @@ pub struct Options {
     pub dim: Option<[f64; 6]>,
     /// Render options (genBSDF's `-ab 5 -ad 700 -lw 3e-6` over rcontrib's defaults).
     pub trace: TraceOptions,
+    /// Also estimate every element's standard error (`-E`).
+    pub errors: bool,
 }
 
 impl Options {
@@ -53,6 +55,7 @@ impl Options {
             backward: true,
             dim: None,
             trace,
+            errors: false,
         }
     }
 }
@@ -102,6 +105,9 @@ pub struct Characterised {
     pub warnings: Vec<String>,
     /// The BSDF (Klems full basis, visible).
     pub bsdf: Bsdf,
+    /// With [`Options::errors`]: the same blocks holding each element's standard error
+    /// (sr⁻¹), from the spread of the per-sample contributions.
+    pub errors: Option<Bsdf>,
 }
 
 /// Characterises the device `scene` (genBSDF's frame) on the Klems full basis.
@@ -156,6 +162,7 @@ pub fn characterise(
         .map(|o| basis.projected_solid_angle(o).unwrap_or(0.0))
         .collect();
     let mut blocks = Vec::new();
+    let mut error_blocks = Vec::new();
     // (light from the room?, transmission direction, reflection direction)
     let mut sides = Vec::new();
     if opts.backward {
@@ -171,12 +178,16 @@ pub fn characterise(
     for (side_k, &(from_room, tdir, rdir)) in sides.iter().enumerate() {
         let z = if from_room { z1 + 1e-5 } else { z0 - 1e-5 };
         // per incident patch: flux fractions toward the far and near receivers, by patch
+        // (indices 0..np far, np..2np near), and their per-sample sums of squares
         let rows: Vec<(Vec<f64>, Vec<f64>)> = pool.install(|| {
             (0..np)
                 .into_par_iter()
                 .map(|i| {
-                    let (mut far, mut near) = (vec![0.0; np], vec![0.0; np]);
+                    let mut sum = vec![0.0; 2 * np];
+                    let mut sq = vec![0.0; if opts.errors { 2 * np } else { 0 }];
+                    let mut hits: Vec<(usize, f64)> = Vec::new();
                     for k in 0..n {
+                        hits.clear();
                         let index = ((side_k * np + i) * n + k) as u64;
                         let mut rng = fenestra_trace::rng::Rng::for_ray(0x6e6e_b5df, index);
                         let (ix, iy) = (k % nx, k / nx);
@@ -201,25 +212,51 @@ pub fn characterise(
                             let o = basis.patch([d.x, d.y, d.z.abs()]);
                             let Some(o) = o else { return };
                             let goes_to_room = d.z > 0.0;
-                            if goes_to_room != from_room {
-                                far[o] += y;
-                            } else {
-                                near[o] += y;
-                            }
+                            let slot = if goes_to_room != from_room { o } else { np + o };
+                            hits.push((slot, y));
                         });
+                        // in tracing order, so -E leaves the values as they are
+                        for &(slot, v) in &hits {
+                            sum[slot] += v;
+                        }
+                        if opts.errors {
+                            // one sample's total per element, then its square
+                            hits.sort_unstable_by_key(|h| h.0);
+                            let mut j = 0;
+                            while j < hits.len() {
+                                let (slot, mut v) = hits[j];
+                                j += 1;
+                                while j < hits.len() && hits[j].0 == slot {
+                                    v += hits[j].1;
+                                    j += 1;
+                                }
+                                sq[slot] += v * v;
+                            }
+                        }
                     }
-                    (far, near)
+                    (sum, sq)
                 })
                 .collect()
         });
-        let matrix = |far_side: bool| {
+        let nf = n as f64;
+        // the mean over the samples (or its standard error) divided by the projected solid angle
+        let matrix = |far_side: bool, error: bool| {
             let mut values = vec![0.0; np * np];
-            for (i, row) in rows.iter().enumerate() {
-                let fractions = if far_side { &row.0 } else { &row.1 };
-                for (o, f) in fractions.iter().enumerate() {
-                    if omega[o] > 0.0 {
-                        values[o * np + i] = f / n as f64 / omega[o];
+            let base = if far_side { 0 } else { np };
+            for (i, (sum, sq)) in rows.iter().enumerate() {
+                for o in 0..np {
+                    if omega[o] <= 0.0 {
+                        continue;
                     }
+                    let mean = sum[base + o] / nf;
+                    values[o * np + i] = if !error {
+                        mean / omega[o]
+                    } else if n > 1 {
+                        let var = ((sq[base + o] / nf - mean * mean) * nf / (nf - 1.0)).max(0.0);
+                        (var / nf).sqrt() / omega[o]
+                    } else {
+                        0.0
+                    };
                 }
             }
             KlemsMatrix {
@@ -228,15 +265,29 @@ pub fn characterise(
                 values,
             }
         };
-        for (dir, m) in [(tdir, matrix(true)), (rdir, matrix(false))] {
-            blocks.push(Block {
+        for (dir, far_side) in [(tdir, true), (rdir, false)] {
+            let block = |error: bool| Block {
                 wavelength: fenestra_bsdf::Wavelength::Visible,
                 direction: dir,
                 data_type: "BTDF".into(),
-                data: BlockData::Klems(m),
-            });
+                data: BlockData::Klems(matrix(far_side, error)),
+            };
+            blocks.push(block(false));
+            if opts.errors {
+                error_blocks.push(block(true));
+            }
         }
     }
+    let errors = opts.errors.then(|| Bsdf {
+        name: "Standard errors".into(),
+        width: Some(w),
+        height: Some(h),
+        thickness: Some(-z0),
+        structure: Some(DataStructure::Columns),
+        bases: vec![basis.clone()],
+        blocks: error_blocks,
+        ..Default::default()
+    });
     let bsdf = Bsdf {
         name: "Unnamed".into(),
         width: Some(w),
@@ -252,6 +303,7 @@ pub fn characterise(
         samples: n,
         warnings,
         bsdf,
+        errors,
     })
 }
 
