@@ -196,7 +196,7 @@ fn oracle_tree_direct_exact() {
 /// its normal (an asymmetric device for this room), a low sun (Jun 21 18:45, altitude 7.7°)
 /// and a building opposite, `-ab 5`: the building hiding the sun (Radiance gave 0 at
 /// `-ab 1` where fenestra gave 9% before) and a low building letting it in. Means over 20
-/// sensors, the oracle's over 4 input orders, ours over 4 seeds, within 4 combined s.e.
+/// sensors, the oracle's over 8 input orders, ours over 8 seeds, within 4 combined s.e.
 #[test]
 fn oracle_west_room_low_sun_ab5() {
     if common::oracle().is_none() {
@@ -237,7 +237,10 @@ fn oracle_west_room_low_sun_ab5() {
     std::fs::write(dir.join("sensors.pts"), pts).unwrap();
     let opts = ["-ab", "5", "-ad", "1024", "-lw", "1e-5"];
     for room in ["room.rad", "low.rad"] {
-        let (t, o) = both(&dir, &[room, "window.rad", "sky.rad"], &opts, 4);
+        // 8 runs each: with 4, a CI run's oracle spread came out 3x smaller than another
+        // run's (0.0011 vs 0.0037) and the 4 s.e. limit failed at 4.4 (the s.e. of 4 samples
+        // is itself uncertain by ~40%)
+        let (t, o) = both(&dir, &[room, "window.rad", "sky.rad"], &opts, 8);
         agree(&format!("west {room} -ab 5"), &t, &o);
     }
 }
