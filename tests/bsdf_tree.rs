@@ -131,7 +131,7 @@ fn oracle_tree_windows_agree_within_noise() {
             "skyfunc_glow.rad",
         ];
         let opts = ["-ab", "1", "-ad", "2048", "-lw", "1e-4"];
-        let (t, o) = both(&dir, &sky, &opts, 4);
+        let (t, o) = both(&dir, &sky, &opts, 8);
         agree(&format!("{tree} overcast -ab 1"), &t, &o);
         let sun = [
             "materials.rad",
@@ -140,7 +140,7 @@ fn oracle_tree_windows_agree_within_noise() {
             "window.rad",
             "sun.rad",
         ];
-        let (t, o) = both(&dir, &sun, &opts, 6);
+        let (t, o) = both(&dir, &sun, &opts, 8);
         agree(&format!("{tree} sun -ab 1"), &t, &o);
     }
 }
