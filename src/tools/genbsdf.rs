@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use fenestra_genbsdf::{characterise, Options};
 
-const USAGE: &str = "[-q][-E errors.xml][-c Nsamp][-n Nproc][-r 'render opts'][{+|-}f[orward]][{+|-}b[ackward]][{+|-}mgf][{+|-}geom unit][-dim x0 x1 y0 y1 z0 z1] [input ..]";
+const USAGE: &str = "[-q][-E errors.xml][{+|-}C][-c Nsamp][-n Nproc][-r 'render opts'][{+|-}f[orward]][{+|-}b[ackward]][{+|-}mgf][{+|-}geom unit][-dim x0 x1 y0 y1 z0 z1] [input ..]";
 
 /// Geometry units genBSDF accepts, with their length in metres.
 const UNITS: [(&str, f64); 5] = [
@@ -85,11 +85,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 o.dim = Some(d);
                 i += 6;
             }
-            "+C" | "-C" => {
-                if plus {
-                    bail!("+C (colour blocks) is not supported by fenestra's genBSDF yet (grey Y data only)");
-                }
-            }
+            "+C" | "-C" => o.colour = plus,
             "-t3" | "-t4" => bail!(
                 "{a}: tensor-tree output is not supported by fenestra's genBSDF yet (Klems only)"
             ),

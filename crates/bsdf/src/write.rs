@@ -3,7 +3,7 @@
 use std::fmt::Write;
 
 use crate::klems::KlemsBasis;
-use crate::model::{BlockData, Bsdf, DataStructure};
+use crate::model::{BlockData, Bsdf, DataStructure, Wavelength};
 
 /// Why a BSDF cannot be written as Klems XML.
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -106,8 +106,13 @@ pub fn klems_xml(b: &Bsdf, comment: Option<&str>) -> Result<String, WriteError> 
         };
         let _ = writeln!(
             out,
-            "\t<WavelengthData>\n\t\t<LayerNumber>System</LayerNumber>\n\t\t<Wavelength unit=\"Integral\">{}</Wavelength>\n\t\t<SourceSpectrum>CIE Illuminant D65 1nm.ssp</SourceSpectrum>\n\t\t<DetectorSpectrum>ASTM E308 1931 Y.dsp</DetectorSpectrum>\n\t\t<WavelengthDataBlock>\n\t\t\t<WavelengthDataDirection>{}</WavelengthDataDirection>\n\t\t\t<ColumnAngleBasis>{}</ColumnAngleBasis>\n\t\t\t<RowAngleBasis>{}</RowAngleBasis>\n\t\t\t<ScatteringDataType>{}</ScatteringDataType>\n\t\t\t<ScatteringData>",
+            "\t<WavelengthData>\n\t\t<LayerNumber>System</LayerNumber>\n\t\t<Wavelength unit=\"Integral\">{}</Wavelength>\n\t\t<SourceSpectrum>CIE Illuminant D65 1nm.ssp</SourceSpectrum>\n\t\t<DetectorSpectrum>{}</DetectorSpectrum>\n\t\t<WavelengthDataBlock>\n\t\t\t<WavelengthDataDirection>{}</WavelengthDataDirection>\n\t\t\t<ColumnAngleBasis>{}</ColumnAngleBasis>\n\t\t\t<RowAngleBasis>{}</RowAngleBasis>\n\t\t\t<ScatteringDataType>{}</ScatteringDataType>\n\t\t\t<ScatteringData>",
             escape(blk.wavelength.xml_name()),
+            match blk.wavelength {
+                Wavelength::CieX => "ASTM E308 1931 X.dsp",
+                Wavelength::CieZ => "ASTM E308 1931 Z.dsp",
+                _ => "ASTM E308 1931 Y.dsp",
+            },
             blk.direction.xml_name(),
             escape(m.incident.name()),
             escape(m.outgoing.name()),
@@ -132,7 +137,7 @@ pub const WRITTEN_STRUCTURE: DataStructure = DataStructure::Columns;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{Block, Direction, KlemsMatrix, Wavelength};
+    use crate::model::{Block, Direction, KlemsMatrix};
 
     #[test]
     fn round_trip() {

@@ -25,6 +25,32 @@ use rayon::prelude::*;
 /// Luminance weights of Radiance's `rmtxop -c y` (no 179 factor), as genBSDF applies them.
 const Y_WEIGHTS: [f64; 3] = [0.265_105_81, 0.670_105_81, 0.064_788_356];
 
+/// CIE X from Radiance's RGB: the matrix of its standard primaries (x, y of R 0.640 0.330,
+/// G 0.290 0.600, B 0.150 0.060) with an equal-energy white, whose Y row is [`Y_WEIGHTS`];
+/// each row sums to 1, so a grey device has X = Y = Z. For `+C`.
+const X_WEIGHTS: [f64; 3] = [0.514_144_621, 0.323_884_48, 0.161_970_899];
+/// CIE Z, as [`X_WEIGHTS`].
+const Z_WEIGHTS: [f64; 3] = [0.024_100_529, 0.122_852_734, 0.853_046_737];
+
+/// What one incident patch gathered, by slot (0..np toward the far side, np..2np back
+/// toward the near side): sums over the samples of Y, of each sample's Y squared (with
+/// `-E`), and of X and Z (with `+C`).
+struct PatchSums {
+    y: Vec<f64>,
+    y_sq: Vec<f64>,
+    x: Vec<f64>,
+    z: Vec<f64>,
+}
+
+/// Which quantity a matrix holds.
+#[derive(Clone, Copy)]
+enum Channel {
+    Y,
+    YError,
+    X,
+    Z,
+}
+
 /// What to characterise and how.
 #[derive(Debug, Clone)]
 pub struct Options {
@@ -40,6 +66,8 @@ pub struct Options {
     pub trace: TraceOptions,
     /// Also estimate every element's standard error (`-E`).
     pub errors: bool,
+    /// Colour (`+C`): CIE-X and CIE-Z blocks beside the `Visible` (Y) ones.
+    pub colour: bool,
 }
 
 impl Options {
@@ -56,6 +84,7 @@ impl Options {
             dim: None,
             trace,
             errors: false,
+            colour: false,
         }
     }
 }
@@ -179,12 +208,14 @@ pub fn characterise(
         let z = if from_room { z1 + 1e-5 } else { z0 - 1e-5 };
         // per incident patch: flux fractions toward the far and near receivers, by patch
         // (indices 0..np far, np..2np near), and their per-sample sums of squares
-        let rows: Vec<(Vec<f64>, Vec<f64>)> = pool.install(|| {
+        let rows: Vec<PatchSums> = pool.install(|| {
             (0..np)
                 .into_par_iter()
                 .map(|i| {
                     let mut sum = vec![0.0; 2 * np];
                     let mut sq = vec![0.0; if opts.errors { 2 * np } else { 0 }];
+                    let mut sx = vec![0.0; if opts.colour { 2 * np } else { 0 }];
+                    let mut sz = sx.clone();
                     let mut hits: Vec<(usize, f64)> = Vec::new();
                     for k in 0..n {
                         hits.clear();
@@ -214,6 +245,13 @@ pub fn characterise(
                             let goes_to_room = d.z > 0.0;
                             let slot = if goes_to_room != from_room { o } else { np + o };
                             hits.push((slot, y));
+                            if opts.colour {
+                                let dot = |w: [f64; 3]| -> f64 {
+                                    c.coef.iter().zip(w).map(|(a, w)| a * w).sum()
+                                };
+                                sx[slot] += dot(X_WEIGHTS);
+                                sz[slot] += dot(Z_WEIGHTS);
+                            }
                         });
                         // in tracing order, so -E leaves the values as they are
                         for &(slot, v) in &hits {
@@ -234,28 +272,36 @@ pub fn characterise(
                             }
                         }
                     }
-                    (sum, sq)
+                    PatchSums {
+                        y: sum,
+                        y_sq: sq,
+                        x: sx,
+                        z: sz,
+                    }
                 })
                 .collect()
         });
         let nf = n as f64;
         // the mean over the samples (or its standard error) divided by the projected solid angle
-        let matrix = |far_side: bool, error: bool| {
+        let matrix = |far_side: bool, channel: Channel| {
             let mut values = vec![0.0; np * np];
             let base = if far_side { 0 } else { np };
-            for (i, (sum, sq)) in rows.iter().enumerate() {
+            for (i, r) in rows.iter().enumerate() {
                 for o in 0..np {
                     if omega[o] <= 0.0 {
                         continue;
                     }
-                    let mean = sum[base + o] / nf;
-                    values[o * np + i] = if !error {
-                        mean / omega[o]
-                    } else if n > 1 {
-                        let var = ((sq[base + o] / nf - mean * mean) * nf / (nf - 1.0)).max(0.0);
-                        (var / nf).sqrt() / omega[o]
-                    } else {
-                        0.0
+                    let k = base + o;
+                    values[o * np + i] = match channel {
+                        Channel::Y => r.y[k] / nf / omega[o],
+                        Channel::X => r.x[k] / nf / omega[o],
+                        Channel::Z => r.z[k] / nf / omega[o],
+                        Channel::YError if n > 1 => {
+                            let mean = r.y[k] / nf;
+                            let var = ((r.y_sq[k] / nf - mean * mean) * nf / (nf - 1.0)).max(0.0);
+                            (var / nf).sqrt() / omega[o]
+                        }
+                        Channel::YError => 0.0,
                     };
                 }
             }
@@ -266,15 +312,21 @@ pub fn characterise(
             }
         };
         for (dir, far_side) in [(tdir, true), (rdir, false)] {
-            let block = |error: bool| Block {
-                wavelength: fenestra_bsdf::Wavelength::Visible,
+            use fenestra_bsdf::Wavelength;
+            let block = |wavelength: Wavelength, channel: Channel| Block {
+                wavelength,
                 direction: dir,
                 data_type: "BTDF".into(),
-                data: BlockData::Klems(matrix(far_side, error)),
+                data: BlockData::Klems(matrix(far_side, channel)),
             };
-            blocks.push(block(false));
+            // wrapBSDF's order: Visible, CIE-X, CIE-Z for each direction
+            blocks.push(block(Wavelength::Visible, Channel::Y));
+            if opts.colour {
+                blocks.push(block(Wavelength::CieX, Channel::X));
+                blocks.push(block(Wavelength::CieZ, Channel::Z));
+            }
             if opts.errors {
-                error_blocks.push(block(true));
+                error_blocks.push(block(Wavelength::Visible, Channel::YError));
             }
         }
     }
