@@ -382,3 +382,116 @@ fn oracle_colour_blocks_match_radiance_chromaticity() {
     // printed with 7 significant digits by both (measured worst 8.4e-7)
     common::agree("dctimestep RGB", &a, &b, 5e-6, 0.0);
 }
+
+/// Every value finite and ≥ 0, and T + R ≤ 1 (plus noise) per incident patch.
+fn check_finite_and_conserving(b: &Bsdf, what: &str) {
+    let vis = Wavelength::Visible;
+    for d in [
+        Direction::TransmissionBack,
+        Direction::ReflectionBack,
+        Direction::TransmissionFront,
+        Direction::ReflectionFront,
+    ] {
+        let m = b.klems(d, &vis).expect("block");
+        assert!(
+            m.values.iter().all(|v| v.is_finite() && *v >= 0.0),
+            "{what} {d:?}: a NaN, infinite or negative value"
+        );
+    }
+    for (t, r) in [
+        (Direction::TransmissionBack, Direction::ReflectionBack),
+        (Direction::TransmissionFront, Direction::ReflectionFront),
+    ] {
+        let (t, r) = (b.klems(t, &vis).unwrap(), b.klems(r, &vis).unwrap());
+        for i in 0..t.incident.len() {
+            let sum = t.hemispherical(i) + r.hemispherical(i);
+            assert!(sum <= 1.02, "{what}: incident patch {i} T+R = {sum}");
+        }
+    }
+}
+
+/// Hard geometry (issue 18): an opaque Lambertian panel (T = 0 everywhere; R = its
+/// reflectance 0.5 at every incidence, since every path ends on one receiver or the other);
+/// horizontal slats whose front edges lie exactly on Z = 0, with incident directions along
+/// their surfaces; 1 mm slats 20 mm apart over a 10 m × 10 m sample. Nothing NaN, negative
+/// or gaining light.
+#[test]
+fn hard_geometry_stays_finite_and_conserving() {
+    let dir = scratch("genbsdf-hard");
+    let mut panel = String::from("void plastic grey\n0\n0\n5 .5 .5 .5 0 0\n");
+    panel.push_str("grey polygon panel\n0\n0\n12 0 0 -0.01 1 0 -0.01 1 1 -0.01 0 1 -0.01\n");
+    // horizontal slats (normal +Y), 25 mm deep, front edge on Z = 0, 20 mm pitch, 0.3 m wide
+    let mut flat = String::from("void plastic slat\n0\n0\n5 .7 .7 .7 0 0\n");
+    for k in 0..15 {
+        let y = 0.01 + 0.02 * k as f64;
+        flat.push_str(&format!(
+            "slat polygon s{k}\n0\n0\n12 0 {y} -0.025 0.3 {y} -0.025 0.3 {y} 0 0 {y} 0\n"
+        ));
+    }
+    // 1 mm thick slats (top and bottom faces, front and back edges), 20 mm pitch, 10 m wide
+    let mut thin = String::from("void plastic slat\n0\n0\n5 .7 .7 .7 0 0\n");
+    for k in 0..500 {
+        let (y0, y1) = (0.02 * k as f64, 0.02 * k as f64 + 0.001);
+        for (n, (a, b, c, d)) in [
+            (
+                (0.0, y0, -0.025),
+                (10.0, y0, -0.025),
+                (10.0, y0, 0.0),
+                (0.0, y0, 0.0),
+            ),
+            (
+                (0.0, y1, -0.025),
+                (0.0, y1, 0.0),
+                (10.0, y1, 0.0),
+                (10.0, y1, -0.025),
+            ),
+            (
+                (0.0, y0, 0.0),
+                (10.0, y0, 0.0),
+                (10.0, y1, 0.0),
+                (0.0, y1, 0.0),
+            ),
+            (
+                (0.0, y0, -0.025),
+                (0.0, y1, -0.025),
+                (10.0, y1, -0.025),
+                (10.0, y0, -0.025),
+            ),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            thin.push_str(&format!(
+                "slat polygon t{k}_{n}\n0\n0\n12 {} {} {} {} {} {} {} {} {} {} {} {}\n",
+                a.0, a.1, a.2, b.0, b.1, b.2, c.0, c.1, c.2, d.0, d.1, d.2
+            ));
+        }
+    }
+    for (name, text, c) in [
+        ("panel", &panel, "20"),
+        ("flat", &flat, "20"),
+        ("thin", &thin, "20"),
+    ] {
+        std::fs::write(dir.join(format!("{name}.rad")), text).unwrap();
+        let mut cmd = fenestra("genBSDF");
+        cmd.args(["-q", "-n", "2", "-c", c, "+f", "+b", &format!("{name}.rad")])
+            .current_dir(&dir);
+        std::fs::write(dir.join(format!("{name}.xml")), run_ok(&mut cmd)).unwrap();
+        let b = read_file(&dir.join(format!("{name}.xml"))).unwrap();
+        check_finite_and_conserving(&b, name);
+        if name == "panel" {
+            let vis = Wavelength::Visible;
+            for d in [Direction::TransmissionBack, Direction::TransmissionFront] {
+                let m = b.klems(d, &vis).unwrap();
+                assert!(m.values.iter().all(|v| *v == 0.0), "panel {d:?}");
+            }
+            for d in [Direction::ReflectionBack, Direction::ReflectionFront] {
+                let m = b.klems(d, &vis).unwrap();
+                for i in 0..m.incident.len() {
+                    let r = m.hemispherical(i);
+                    assert!((r - 0.5).abs() < 0.01, "panel {d:?} patch {i}: R {r}");
+                }
+            }
+        }
+    }
+}
