@@ -150,11 +150,21 @@ impl Tracer {
                 val += self.spawn(r, s, d, TRANS, color * tspec, cx);
             }
         }
-        if rdiff > FTINY {
-            val += self.ambient(r, p, nrm, color * rdiff, Some(shape), cx);
+        // A rough lobe too weak to sample (not above -st) joins the ambient coefficient of
+        // its side, as Radiance's "below threshold" rule does: its energy is not lost.
+        let mut ramb = color * rdiff;
+        if rspec > FTINY && !pure && rspec <= self.opts.st {
+            ramb += scolor;
         }
-        if tdiff > FTINY {
-            val += self.ambient(r, p, -nrm, color * tdiff, Some(shape), cx);
+        let mut tamb = color * tdiff;
+        if tspec > FTINY && !pure && tspec <= self.opts.st {
+            tamb += color * tspec;
+        }
+        if ramb.max_element() > FTINY {
+            val += self.ambient(r, p, nrm, ramb, Some(shape), cx);
+        }
+        if tamb.max_element() > FTINY {
+            val += self.ambient(r, p, -nrm, tamb, Some(shape), cx);
         }
         if last {
             val += self.direct(r, Lit::on(p, nrm, shape), val, cx, lobe);
