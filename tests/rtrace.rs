@@ -400,3 +400,32 @@ fn defaults_version_and_warnings_as_radiance() {
     let o = common::run_stdin(c, b"0 0 0 0 0 1\n");
     assert!(String::from_utf8_lossy(&o.stderr).contains("no light sources found"));
 }
+
+/// A rough specular lobe too weak to sample (not above `-st`, default 0.15) joins its side's
+/// ambient coefficient, as in Radiance: plastic (spec .02, rough .05), metal (spec .1, rough
+/// .1) and a rough `trans` panel under a uniform glow sky (radiance 1 everywhere, so every
+/// ambient sample sees 1 and `-ab 1` is exact in both tools). Each value is the
+/// material's whole reflectance or transmittance on that side; tolerance 1e-4 (printed digits,
+/// single-precision colours in Radiance). fenestra lost the lobe before (plastic 0.588 for
+/// Radiance's 0.608 in red).
+#[test]
+fn oracle_weak_rough_lobes_join_the_ambient() {
+    let Some(o) = common::oracle() else { return };
+    let dir = common::scratch("rtrace-weak-lobes");
+    let scene = "void glow skyglow\n0\n0\n4 1 1 1 0\nskyglow source sky\n0\n0\n4 0 0 1 180\n\
+        skyglow source ground\n0\n0\n4 0 0 -1 180\n\
+        void plastic pl\n0\n0\n5 .6 .55 .5 .02 .05\n\
+        pl polygon f1\n0\n0\n12 -100 -100 0 -1 -100 0 -1 100 0 -100 100 0\n\
+        void metal me\n0\n0\n5 .6 .55 .5 .1 .1\n\
+        me polygon f2\n0\n0\n12 1 -100 0 100 -100 0 100 100 0 1 100 0\n\
+        void trans tr\n0\n0\n7 .6 .55 .5 .03 .08 .5 .1\n\
+        tr polygon f3\n0\n0\n12 -1 -100 0 1 -100 0 1 100 0 -1 100 0\n";
+    std::fs::write(dir.join("scene.rad"), scene).unwrap();
+    // down onto each panel (reflection), and up at the trans panel from below (transmission
+    // and reflection of the lower side)
+    let rays = "-50 0 1 0 0 -1\n50 0 1 0 0 -1\n0 0 1 0 0 -1\n0 0 -1 0 0 1\n";
+    let opts = ["-h", "-ab", "1", "-aa", "0", "-ad", "64", "-lw", "1e-4"];
+    let (theirs, ours) = common::both_rtrace(&o, &dir, &opts, rays);
+    eprintln!("oracle {theirs:?}\nours   {ours:?}");
+    common::agree("weak rough lobes", &theirs, &ours, 1e-4, 1e-6);
+}
