@@ -429,3 +429,50 @@ fn oracle_weak_rough_lobes_join_the_ambient() {
     eprintln!("oracle {theirs:?}\nours   {ours:?}");
     common::agree("weak rough lobes", &theirs, &ours, 1e-4, 1e-6);
 }
+
+/// Rough specular lobes above `-st` are sampled, reflected and transmitted, at `-ss 1` and at
+/// `-ss 0` (one fixed direction, the lobe's median, as Radiance): a rough `trans` panel
+/// (transmitted specular 0.25 > 0.15) over a rough plastic floor (spec .3), uniform glow sky
+/// above and below, `-ab 1`. Before, fenestra lost the transmitted lobe (0.153 seen from
+/// below for Radiance's 0.315) and at `-ss 0` the reflected one too. Means of 30 copies of
+/// each ray.
+#[test]
+fn oracle_rough_specular_lobes_are_sampled() {
+    let Some(o) = common::oracle() else { return };
+    let dir = common::scratch("rtrace-rough-lobes");
+    let scene = "void glow skyglow\n0\n0\n4 1 1 1 0\nskyglow source sky\n0\n0\n4 0 0 1 180\n\
+        skyglow source ground\n0\n0\n4 0 0 -1 180\n\
+        void trans tr\n0\n0\n7 .6 .55 .5 0 .1 .5 .5\n\
+        tr polygon panel\n0\n0\n12 -100 -100 0 100 -100 0 100 100 0 -100 100 0\n\
+        void plastic pl\n0\n0\n5 .6 .55 .5 .3 .1\n\
+        pl polygon floor\n0\n0\n12 -100 -100 -5 100 -100 -5 100 100 -5 -100 100 -5\n";
+    std::fs::write(dir.join("scene.rad"), scene).unwrap();
+    let kinds = ["0 0 1 0 0 -1\n", "0 0 -1 0 0 1\n", "0 0 -4 0 0 -1\n"];
+    let rays: String = kinds
+        .iter()
+        .flat_map(|k| std::iter::repeat_n(*k, 30))
+        .collect();
+    for ss in ["1", "0"] {
+        let opts = ["-h", "-ab", "1", "-aa", "0", "-ad", "512", "-ss", ss];
+        let (theirs, ours) = common::both_rtrace(&o, &dir, &opts, &rays);
+        // green channel of each copy, by ray kind
+        for (k, kind) in kinds.iter().enumerate() {
+            let pick = |v: &[f64]| -> Vec<f64> {
+                v.chunks(3).skip(30 * k).take(30).map(|c| c[1]).collect()
+            };
+            let (ta, ts) = common::mean_sem(&pick(&theirs));
+            let (oa, os) = common::mean_sem(&pick(&ours));
+            eprintln!(
+                "-ss {ss} ray {}: oracle {ta:.4} ± {ts:.4}, ours {oa:.4} ± {os:.4}",
+                kind.trim()
+            );
+            // all three paths go through the rough transmitted lobe and come out 0.5-0.8% high
+            // (0.3002 vs 0.2985, 0.2878 vs 0.2858, 0.1397 vs 0.1389 at -ss 1; over 5 s.e. each):
+            // a residual not yet explained, held within 1.5% so that it cannot grow unseen
+            assert!(
+                (ta - oa).abs() <= 0.015 * ta,
+                "-ss {ss} ray {k}: {ta} vs {oa}"
+            );
+        }
+    }
+}

@@ -132,9 +132,10 @@ impl Tracer {
             if rspec > FTINY && pure {
                 let dir = (d + nrm * (2.0 * pdot)).normalize();
                 val += self.spawn(r, s, dir, REFLECTED, scolor, cx);
-            } else if rspec > FTINY && self.opts.ss > 0.0 && rspec > self.opts.st {
-                // one Ward-lobe sample (isotropic)
-                let (u, v) = (cx.rng.next_f64(), cx.rng.next_f64());
+            } else if rspec > FTINY && rspec > self.opts.st {
+                // one Ward-lobe sample (isotropic); below -ss 1 the variates are pulled
+                // toward the lobe's median, -ss 0 giving one fixed direction (Radiance's rule)
+                let (u, v) = self.spec_variates(cx);
                 let tan2 = -alpha2 * (1.0 - u).max(1e-300).ln();
                 let ct = 1.0 / (1.0 + tan2).sqrt();
                 let st = (1.0 - ct * ct).max(0.0).sqrt();
@@ -148,6 +149,17 @@ impl Tracer {
             }
             if tspec > FTINY && pure {
                 val += self.spawn(r, s, d, TRANS, color * tspec, cx);
+            } else if tspec > FTINY && tspec > self.opts.st {
+                // the rough transmitted lobe: one Gaussian-spread sample about the ray's
+                // direction, kept when it still leaves through the far side
+                let (u, v) = self.spec_variates(cx);
+                let spread = (-alpha2 * (1.0 - u).max(1e-300).ln()).sqrt();
+                let (a, b) = frame(d);
+                let phi = 2.0 * PI * v;
+                let dir = (d + (a * phi.cos() + b * phi.sin()) * spread).normalize();
+                if dir.dot(nrm) < 0.0 {
+                    val += self.spawn(r, s, dir, SPECULAR | TRANS, color * tspec, cx);
+                }
             }
         }
         // A rough lobe too weak to sample (not above -st) joins the ambient coefficient of
@@ -170,5 +182,18 @@ impl Tracer {
             val += self.direct(r, Lit::on(p, nrm, shape), val, cx, lobe);
         }
         val
+    }
+
+    /// Two variates for a specular lobe sample: uniform at `-ss` ≥ 1, pulled toward ½ by
+    /// the factor `-ss` below it (so `-ss 0` samples the lobe's median direction).
+    fn spec_variates(&self, cx: &mut Ctx) -> (f64, f64) {
+        let (u, v) = (cx.rng.next_f64(), cx.rng.next_f64());
+        let j = self.opts.ss;
+        if j >= 1.0 {
+            (u, v)
+        } else {
+            let j = j.max(0.0);
+            (0.5 + j * (u - 0.5), 0.5 + j * (v - 0.5))
+        }
     }
 }
