@@ -6,6 +6,14 @@ mod common;
 use common::{fenestra, fixture, run_ok, run_stdin, scratch};
 use fenestra_bsdf::{read_file, Bsdf, Direction, KlemsBasis, Wavelength};
 
+/// The four Klems blocks genBSDF writes with `+f +b`.
+const ALL_BLOCKS: [Direction; 4] = [
+    Direction::TransmissionBack,
+    Direction::ReflectionBack,
+    Direction::TransmissionFront,
+    Direction::ReflectionFront,
+];
+
 /// Diffuse-incidence hemispherical total of a component: Σ λ_i · total(i) / π.
 fn diffuse_total(b: &Bsdf, d: Direction) -> f64 {
     let m = b.klems(d, &Wavelength::Visible).expect("component");
@@ -281,12 +289,7 @@ fn standard_errors_explain_the_difference_from_radiance() {
     let err = read_file(&dir.join("err.xml")).unwrap();
     let theirs = read_file(&fixture("threephase/blinds_kf.xml")).unwrap();
     let vis = Wavelength::Visible;
-    for d in [
-        Direction::TransmissionBack,
-        Direction::ReflectionBack,
-        Direction::TransmissionFront,
-        Direction::ReflectionFront,
-    ] {
+    for d in ALL_BLOCKS {
         let (o, e, t) = (
             &ours.klems(d, &vis).unwrap().values,
             &err.klems(d, &vis).unwrap().values,
@@ -345,12 +348,7 @@ fn oracle_colour_blocks_match_radiance_chromaticity() {
     let sum = |b: &Bsdf, d: Direction, w: Wavelength| -> f64 {
         b.klems(d, &w).expect("block").values.iter().sum()
     };
-    for d in [
-        Direction::TransmissionBack,
-        Direction::ReflectionBack,
-        Direction::TransmissionFront,
-        Direction::ReflectionFront,
-    ] {
+    for d in ALL_BLOCKS {
         for w in [Wavelength::CieX, Wavelength::CieZ] {
             let ratio = |b: &Bsdf| sum(b, d, w.clone()) / sum(b, d, Wavelength::Visible);
             let (a, b) = (ratio(&theirs), ratio(&ours));
@@ -386,12 +384,7 @@ fn oracle_colour_blocks_match_radiance_chromaticity() {
 /// Every value finite and ≥ 0, and T + R ≤ 1 (plus noise) per incident patch.
 fn check_finite_and_conserving(b: &Bsdf, what: &str) {
     let vis = Wavelength::Visible;
-    for d in [
-        Direction::TransmissionBack,
-        Direction::ReflectionBack,
-        Direction::TransmissionFront,
-        Direction::ReflectionFront,
-    ] {
+    for d in ALL_BLOCKS {
         let m = b.klems(d, &vis).expect("block");
         assert!(
             m.values.iter().all(|v| v.is_finite() && *v >= 0.0),

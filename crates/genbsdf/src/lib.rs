@@ -330,18 +330,8 @@ pub fn characterise(
             }
         }
     }
-    let errors = opts.errors.then(|| Bsdf {
-        name: "Standard errors".into(),
-        width: Some(w),
-        height: Some(h),
-        thickness: Some(-z0),
-        structure: Some(DataStructure::Columns),
-        bases: vec![basis.clone()],
-        blocks: error_blocks,
-        ..Default::default()
-    });
-    let bsdf = Bsdf {
-        name: "Unnamed".into(),
+    let file = |name: &str, blocks: Vec<Block>| Bsdf {
+        name: name.into(),
         width: Some(w),
         height: Some(h),
         thickness: Some(-z0),
@@ -350,6 +340,10 @@ pub fn characterise(
         blocks,
         ..Default::default()
     };
+    let errors = opts
+        .errors
+        .then(|| file("Standard errors", std::mem::take(&mut error_blocks)));
+    let bsdf = file("Unnamed", blocks);
     Ok(Characterised {
         dim,
         samples: n,
