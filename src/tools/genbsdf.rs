@@ -5,7 +5,7 @@ use std::io::Write;
 use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
-use fenestra_genbsdf::{characterise, Options};
+use fenestra_genbsdf::{characterise_with, Options};
 
 const USAGE: &str = "[-q][-E errors.xml][{+|-}C][-c Nsamp][-n Nproc][-r 'render opts'][{+|-}f[orward]][{+|-}b[ackward]][{+|-}mgf][{+|-}geom unit][-dim x0 x1 y0 y1 z0 z1] [input ..]";
 
@@ -149,7 +149,12 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         bail!("no device geometry in the input");
     }
     let pool = fenestra_cli::threads::pool(nproc)?;
-    let got = characterise(&scene, &o, &pool)?;
+    let progress = fenestra_cli::progress::Progress::new(
+        fenestra_genbsdf::directions(&o),
+        "genBSDF incident directions",
+    );
+    let got = characterise_with(&scene, &o, &pool, &|| progress.inc(1))?;
+    progress.finish();
     for w in &got.warnings {
         fenestra_cli::warn(w);
     }

@@ -145,6 +145,22 @@ pub fn characterise(
     opts: &Options,
     pool: &rayon::ThreadPool,
 ) -> Result<Characterised> {
+    characterise_with(scene, opts, pool, &|| {})
+}
+
+/// Number of incident directions a run traces (the Klems patches, per side asked for), for
+/// progress bars.
+pub fn directions(opts: &Options) -> u64 {
+    KlemsBasis::full().len() as u64 * (u64::from(opts.forward) + u64::from(opts.backward))
+}
+
+/// [`characterise`], calling `done` after each incident direction (from worker threads).
+pub fn characterise_with(
+    scene: &Scene,
+    opts: &Options,
+    pool: &rayon::ThreadPool,
+    done: &(dyn Fn() + Sync),
+) -> Result<Characterised> {
     if !opts.forward && !opts.backward {
         bail!("nothing to do: neither +forward nor +backward");
     }
@@ -272,6 +288,7 @@ pub fn characterise(
                             }
                         }
                     }
+                    done();
                     PatchSums {
                         y: sum,
                         y_sq: sq,
