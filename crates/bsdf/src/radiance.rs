@@ -127,6 +127,11 @@ pub enum MatrixError {
 /// CIE XYZ → RGB for Radiance's standard primaries (R .640 .330, G .290 .600, B .150 .060,
 /// white = equal energy 1/3 1/3).
 pub fn xyz_to_rgb_matrix() -> [[f64; 3]; 3] {
+    inv3(&rgb_to_xyz_matrix())
+}
+
+/// RGB → CIE XYZ for the same primaries: rows X, Y, Z, each summing to 1 (a grey is X = Y = Z).
+pub fn rgb_to_xyz_matrix() -> [[f64; 3]; 3] {
     let prim = [(0.640, 0.330), (0.290, 0.600), (0.150, 0.060)];
     let (wx, wy) = (1.0 / 3.0, 1.0 / 3.0);
     // Columns: XYZ of each primary with Y = 1, scaled so R+G+B = white (Y_w = 1).
@@ -139,12 +144,11 @@ pub fn xyz_to_rgb_matrix() -> [[f64; 3]; 3] {
     ];
     let w = [wx / wy, 1.0, (1.0 - wx - wy) / wy];
     let s = mul3(&inv3(&m), w);
-    let rgb2xyz = [
+    [
         [m[0][0] * s[0], m[0][1] * s[1], m[0][2] * s[2]],
         [m[1][0] * s[0], m[1][1] * s[1], m[1][2] * s[2]],
         [m[2][0] * s[0], m[2][1] * s[1], m[2][2] * s[2]],
-    ];
-    inv3(&rgb2xyz)
+    ]
 }
 
 fn mul3(m: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {

@@ -22,16 +22,6 @@ use fenestra_scene::Scene;
 use fenestra_trace::{DVec3, TraceOptions, Tracer};
 use rayon::prelude::*;
 
-/// Luminance weights of Radiance's `rmtxop -c y` (no 179 factor), as genBSDF applies them.
-const Y_WEIGHTS: [f64; 3] = [0.265_105_81, 0.670_105_81, 0.064_788_356];
-
-/// CIE X from Radiance's RGB: the matrix of its standard primaries (x, y of R 0.640 0.330,
-/// G 0.290 0.600, B 0.150 0.060) with an equal-energy white, whose Y row is [`Y_WEIGHTS`];
-/// each row sums to 1, so a grey device has X = Y = Z. For `+C`.
-const X_WEIGHTS: [f64; 3] = [0.514_144_621, 0.323_884_48, 0.161_970_899];
-/// CIE Z, as [`X_WEIGHTS`].
-const Z_WEIGHTS: [f64; 3] = [0.024_100_529, 0.122_852_734, 0.853_046_737];
-
 /// What one incident patch gathered, by slot (0..np toward the far side, np..2np back
 /// toward the near side): sums over the samples of Y, of each sample's Y squared (with
 /// `-E`), and of X and Z (with `+C`).
@@ -189,6 +179,9 @@ pub fn characterise_with(
     parser.add_str(RECEIVERS, "genBSDF receivers")?;
     let full = parser.finish();
     let tracer = Tracer::new(&full, &opts.trace)?;
+    // CIE X, Y, Z of an RGB contribution: Radiance's primaries with an equal-energy white
+    // (Y alone for `Visible`; X and Z too with `+C`)
+    let [x_w, y_w, z_w] = fenestra_bsdf::radiance::rgb_to_xyz_matrix();
     let find = |name: &str| full.prims.iter().position(|p| p.name == name);
     let (Some(face), Some(behind)) = (
         find("genbsdf_receiver_face"),
@@ -253,7 +246,10 @@ pub fn characterise_with(
                         };
                         let org = DVec3::new(px, py, z);
                         tracer.contributions(index, org, dir, &tracked, &mut |c| {
-                            let y: f64 = c.coef.iter().zip(Y_WEIGHTS).map(|(a, w)| a * w).sum();
+                            let dot = |w: [f64; 3]| -> f64 {
+                                c.coef.iter().zip(w).map(|(a, w)| a * w).sum()
+                            };
+                            let y = dot(y_w);
                             let d = c.dir;
                             // the outgoing direction folded onto +Z
                             let o = basis.patch([d.x, d.y, d.z.abs()]);
@@ -262,11 +258,8 @@ pub fn characterise_with(
                             let slot = if goes_to_room != from_room { o } else { np + o };
                             hits.push((slot, y));
                             if opts.colour {
-                                let dot = |w: [f64; 3]| -> f64 {
-                                    c.coef.iter().zip(w).map(|(a, w)| a * w).sum()
-                                };
-                                sx[slot] += dot(X_WEIGHTS);
-                                sz[slot] += dot(Z_WEIGHTS);
+                                sx[slot] += dot(x_w);
+                                sz[slot] += dot(z_w);
                             }
                         });
                         // in tracing order, so -E leaves the values as they are
