@@ -15,6 +15,7 @@ pub mod getinfo;
 pub mod oconv;
 pub mod pcomb;
 pub mod rcalc;
+pub mod rfluxmtx;
 pub mod rmtxop;
 pub mod rtcontrib;
 pub mod rtrace;
@@ -42,6 +43,7 @@ pub fn registry() -> &'static [(&'static str, Run)] {
         ("pcomb", pcomb::run),
         ("rcalc", rcalc::run),
         ("rcontrib", rtcontrib::run),
+        ("rfluxmtx", rfluxmtx::run),
         ("rmtxop", rmtxop::run),
         ("rtcontrib", rtcontrib::run),
         ("rtrace", rtrace::run),

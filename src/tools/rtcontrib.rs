@@ -46,6 +46,28 @@ fn word(args: &[String], i: usize) -> Result<&str> {
 
 /// Runs rtcontrib (also installed as rcontrib).
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
+    let stdin: Box<dyn std::io::BufRead> = Box::new(std::io::BufReader::with_capacity(
+        1 << 16,
+        std::io::stdin().lock(),
+    ));
+    run_with(args, stdin, None)
+}
+
+/// A scene loaded by the caller, with the header lines that describe it.
+pub struct Preloaded {
+    /// The scene.
+    pub scene: fenestra_scene::Scene,
+    /// Lines written at the top of every output header (e.g. the command that made it).
+    pub header: Vec<String>,
+}
+
+/// Runs rcontrib's command line `args` on rays read from `rays`; with a preloaded scene,
+/// the command line names no scene files (rfluxmtx passes its scene and rays this way).
+pub fn run_with(
+    args: Vec<String>,
+    rays: Box<dyn std::io::BufRead>,
+    preloaded: Option<Preloaded>,
+) -> Result<ExitCode> {
     if args.iter().skip(1).any(|a| a == "--help") {
         println!(
             "{} {USAGE}\nTraces rays read from standard input (origin direction; with -I point normal) and writes, for each record, the contribution coefficients of the tracked modifiers per bin.\nSee docs/tools/rtcontrib.md.",
@@ -320,7 +342,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     if mods.is_empty() {
         bail!("missing required modifier argument");
     }
-    if files.is_empty() {
+    if files.is_empty() && preloaded.is_none() {
         bail!(
             "missing scene file\nusage: {} {USAGE}",
             fenestra_cli::prog()
@@ -333,8 +355,14 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     }
 
     let refs: Vec<&str> = files.iter().map(String::as_str).collect();
-    let scene = fenestra_scene::load(&refs)?;
     let mut scene_lines = Vec::new();
+    let scene = match preloaded {
+        Some(p) => {
+            scene_lines = p.header;
+            p.scene
+        }
+        None => fenestra_scene::load(&refs)?,
+    };
     if files.len() == 1 && files[0] != "-" {
         if let Ok(bytes) = std::fs::read(&files[0]) {
             if fenestra_scene::compiled::is_compiled(&bytes) {
@@ -392,11 +420,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     } else {
         None
     };
-    let stdin = std::io::stdin();
-    let mut input = RayInput::new(
-        std::io::BufReader::with_capacity(1 << 16, stdin.lock()),
-        fin,
-    );
+    let mut input = RayInput::new(rays, fin);
     // Rays are read as they are traced (records stream out, flushed where Radiance
     // flushes), except where the whole input is needed first: bins found by a first pass
     // (rtcontrib without -bn) and the single sum of -c 0.

@@ -80,7 +80,7 @@ pub fn frame(vd: [f64; 3], vu: [f64; 3]) -> Result<(DVec3, DVec3, DVec3)> {
 }
 
 /// A polygon of the scene that forms part of the aperture, as triangles.
-fn triangulate(pts: &[DVec3]) -> Vec<[DVec3; 3]> {
+pub(crate) fn triangulate(pts: &[DVec3]) -> Vec<[DVec3; 3]> {
     // Project on the polygon's plane (Newell normal) and clip ears; fall back to a fan.
     let mut n = DVec3::ZERO;
     for i in 0..pts.len() {

@@ -7,4 +7,5 @@ pub mod engine;
 pub mod klemsamp;
 pub mod native;
 pub mod output;
+pub mod rflux;
 pub mod run;
