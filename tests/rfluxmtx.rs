@@ -562,3 +562,66 @@ fn bad_input_gets_radiance_s_errors() {
         "rcv.rad:3",
     );
 }
+
+/// Sum over a picture's pixels of the green channel.
+fn picture_sum(path: &Path) -> f64 {
+    let f = std::fs::File::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut r = std::io::BufReader::new(f);
+    let p = fenestra_formats::picture::Picture::read(&mut r, "test").unwrap();
+    p.pixels.iter().map(|px| px[1] as f64).sum()
+}
+
+#[test]
+fn oracle_pass_through_view_pictures() {
+    // vwrays | rfluxmtx -ffc -x -y -o v%03d.hdr - window.rad scene (the picture form of V)
+    // with -ab 0: a pixel's value is 1 where its ray sees the window in that Klems bin, else
+    // 0, so both tools must write the same 145 files with the same per-bin pixel sums
+    // (exact up to rays that graze a bin boundary: at most one pixel per picture; RGBE
+    // rounding of 1.0 is exact).
+    let Some(o) = common::oracle() else { return };
+    let root = common::scratch("rflux-pictures");
+    let view = common::fixture("vwrays").join("view.vf");
+    let mut vw = common::fenestra("vwrays");
+    vw.args(["-ff", "-x", "24", "-y", "24", "-vf"]).arg(&view);
+    let rays = common::run_ok(&mut vw);
+    let mut dims = common::fenestra("vwrays");
+    dims.args(["-d", "-x", "24", "-y", "24", "-vf"]).arg(&view);
+    let d = String::from_utf8(common::run_ok(&mut dims)).unwrap();
+    let d: Vec<&str> = d.split_whitespace().collect();
+    let mut args = vec!["-ffc"];
+    args.extend(d.iter().copied());
+    args.extend(["-ab", "0", "-o", "v%03d.hdr", "-"]);
+    for side in ["theirs", "ours"] {
+        let dir = root.join(side);
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut c = if side == "theirs" {
+            o.command("rfluxmtx")
+        } else {
+            common::fenestra("rfluxmtx")
+        };
+        c.args(&args)
+            .arg(tp("window_rflux.rad"))
+            .args(office())
+            .current_dir(&dir);
+        let out = common::run_stdin(c, &rays);
+        assert!(
+            out.status.success(),
+            "{side}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let mut seen = 0.0;
+    for k in 0..145 {
+        let name = format!("v{k:03}.hdr");
+        let a = picture_sum(&root.join("ours").join(&name));
+        let b = picture_sum(&root.join("theirs").join(&name));
+        assert!((a - b).abs() <= 1.0 + 1e-6, "{name}: {a} vs {b}");
+        seen += b;
+    }
+    assert!(
+        seen > 20.0,
+        "the view should see the window ({seen} pixels)"
+    );
+    assert!(!root.join("ours/v145.hdr").exists());
+    let _ = std::fs::remove_dir_all(&root);
+}

@@ -148,8 +148,9 @@ struct Cursor<'a> {
 }
 
 impl<'a> Cursor<'a> {
-    fn line(&self) -> usize {
-        self.text[..self.pos].matches('\n').count() + 1
+    /// Line number of a byte position (counted only when a message needs it).
+    fn line_at(&self, pos: usize) -> usize {
+        self.text[..pos].matches('\n').count() + 1
     }
 
     fn skip_space(&mut self) {
@@ -181,13 +182,13 @@ impl<'a> Cursor<'a> {
     }
 
     fn count(&mut self, what: &str) -> Result<usize> {
-        let line = self.line();
         let w = self.word(what)?;
         match w.parse::<usize>() {
             Ok(n) if n <= 1 << 24 => Ok(n),
             _ => bail!(
-                "{}:{line}: expected {what} (an argument count), found '{w}'",
-                self.origin
+                "{}:{}: expected {what} (an argument count), found '{w}'",
+                self.origin,
+                self.line_at(self.pos)
             ),
         }
     }
@@ -227,7 +228,6 @@ fn parse_text(
             }
             continue;
         }
-        let line = c.line();
         let modifier = c.word("a modifier")?.to_string();
         let ptype = c.word("a primitive type")?.to_string();
         let name = c.word("a primitive name")?.to_string();
@@ -246,14 +246,15 @@ fn parse_text(
         let nr = c.count("the number of real arguments")?;
         let mut reals = Vec::with_capacity(nr.min(4096));
         for _ in 0..nr {
-            let l = c.line();
             let w = c.word("a real argument")?;
             match fenestra_cli::opts::parse_real(w) {
                 Some(v) if v.is_finite() => reals.push(v),
-                _ => bail!("{origin}:{l}: '{name}': expected a real argument, found '{w}'"),
+                _ => bail!(
+                    "{origin}:{}: '{name}': expected a real argument, found '{w}'",
+                    c.line_at(c.pos)
+                ),
             }
         }
-        let _ = line;
         items.push(Item::Prim(Prim {
             modifier,
             ptype,
