@@ -12,6 +12,7 @@ pub mod genklemsamp;
 pub mod gensky;
 pub mod genskyvec;
 pub mod getinfo;
+pub mod mkillum;
 pub mod oconv;
 pub mod pcomb;
 pub mod rcalc;
@@ -39,6 +40,7 @@ pub fn registry() -> &'static [(&'static str, Run)] {
         ("gensky", gensky::run),
         ("genskyvec", genskyvec::run),
         ("getinfo", getinfo::run),
+        ("mkillum", mkillum::run),
         ("oconv", oconv::run),
         ("pcomb", pcomb::run),
         ("rcalc", rcalc::run),

@@ -34,9 +34,65 @@ impl Rng {
     }
 }
 
+/// Order of the Hilbert curve that spreads one stratified number over a square (4096²).
+const CURVE_ORDER: u32 = 12;
+
+/// (x, y) of cell `d` along a Hilbert curve over a 2^order square.
+pub fn hilbert_cell(order: u32, mut d: u64) -> (u64, u64) {
+    let (mut x, mut y) = (0u64, 0u64);
+    let mut s = 1u64;
+    while s < (1u64 << order) {
+        let rx = 1 & (d / 2);
+        let ry = 1 & (d ^ rx);
+        if ry == 0 {
+            if rx == 1 {
+                x = s - 1 - x;
+                y = s - 1 - y;
+            }
+            std::mem::swap(&mut x, &mut y);
+        }
+        x += s * rx;
+        y += s * ry;
+        d /= 4;
+        s *= 2;
+    }
+    (x, y)
+}
+
+/// Two numbers in [0,1)² from one: `t` picks a cell along the Hilbert curve (so numbers
+/// stratified in [0,1) give points stratified over the square), `rng` places the point in it.
+pub fn spread2(t: f64, rng: &mut Rng) -> (f64, f64) {
+    let side = 1u64 << CURVE_ORDER;
+    let cells = side * side;
+    let d = ((t.clamp(0.0, 1.0) * cells as f64) as u64).min(cells - 1);
+    let (x, y) = hilbert_cell(CURVE_ORDER, d);
+    (
+        (x as f64 + rng.next_f64()) / side as f64,
+        (y as f64 + rng.next_f64()) / side as f64,
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn hilbert_cells_cover_the_square_once() {
+        let mut seen = [false; 64];
+        for d in 0..64 {
+            let (x, y) = hilbert_cell(3, d);
+            assert!(!seen[(y * 8 + x) as usize]);
+            seen[(y * 8 + x) as usize] = true;
+            if d > 0 {
+                let (px, py) = hilbert_cell(3, d - 1);
+                assert_eq!(
+                    px.abs_diff(x) + py.abs_diff(y),
+                    1,
+                    "neighbours along the curve"
+                );
+            }
+        }
+    }
 
     #[test]
     fn streams_are_reproducible_and_distinct() {

@@ -35,7 +35,7 @@ use shade_normal::NormalLobes;
 mod threshold;
 
 use ambient::frame;
-pub use query::FirstHit;
+pub use query::{FirstHit, SourceLight};
 
 /// Most parts of a flat or cylinder source under `-ds` (Radiance's MAXSPART).
 const MAX_PARTS: usize = 64;

@@ -4,14 +4,11 @@
 //! so the rays are the same for any thread count and from run to run.
 
 use anyhow::{bail, Result};
-use fenestra_trace::rng::Rng;
+use fenestra_trace::rng::{spread2, Rng};
 use glam::DVec3;
 
 use super::directive::Basis;
 use super::surfaces::{Group, Shape, Surface};
-
-/// Order of the Hilbert curve that spreads one stratified number over a square (4096²).
-const CURVE_ORDER: u32 = 12;
 
 /// One surface prepared for sampling origins.
 #[derive(Debug, Clone)]
@@ -47,41 +44,6 @@ fn reinhart_row_len(mf: usize, row: usize) -> usize {
     } else {
         mf * TREGENZA[row / mf]
     }
-}
-
-/// (x, y) of cell `d` along a Hilbert curve over a 2^order square.
-fn hilbert_cell(order: u32, mut d: u64) -> (u64, u64) {
-    let (mut x, mut y) = (0u64, 0u64);
-    let mut s = 1u64;
-    while s < (1u64 << order) {
-        let rx = 1 & (d / 2);
-        let ry = 1 & (d ^ rx);
-        if ry == 0 {
-            if rx == 1 {
-                x = s - 1 - x;
-                y = s - 1 - y;
-            }
-            std::mem::swap(&mut x, &mut y);
-        }
-        x += s * rx;
-        y += s * ry;
-        d /= 4;
-        s *= 2;
-    }
-    (x, y)
-}
-
-/// Two numbers in [0,1)² from one: `t` picks a cell along the Hilbert curve (so numbers
-/// stratified in [0,1) give points stratified over the square), `rng` places the point in it.
-fn spread2(t: f64, rng: &mut Rng) -> (f64, f64) {
-    let side = 1u64 << CURVE_ORDER;
-    let cells = side * side;
-    let d = ((t.clamp(0.0, 1.0) * cells as f64) as u64).min(cells - 1);
-    let (x, y) = hilbert_cell(CURVE_ORDER, d);
-    (
-        (x as f64 + rng.next_f64()) / side as f64,
-        (y as f64 + rng.next_f64()) / side as f64,
-    )
 }
 
 /// Shirley and Chiu's concentric map of the unit square onto the unit disk.
@@ -388,24 +350,6 @@ impl std::io::Read for RayStream {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn hilbert_cells_cover_the_square_once() {
-        let mut seen = [false; 64];
-        for d in 0..64 {
-            let (x, y) = hilbert_cell(3, d);
-            assert!(!seen[(y * 8 + x) as usize]);
-            seen[(y * 8 + x) as usize] = true;
-            if d > 0 {
-                let (px, py) = hilbert_cell(3, d - 1);
-                assert_eq!(
-                    px.abs_diff(x) + py.abs_diff(y),
-                    1,
-                    "neighbours along the curve"
-                );
-            }
-        }
-    }
 
     #[test]
     fn concentric_map_stays_in_the_disk_and_preserves_area() {

@@ -289,3 +289,44 @@ impl Tracer {
         self.contributions_flagged(ray_index, (org, dir, len), IRRAD, tracked, sink)
     }
 }
+
+/// One light-source sample seen from a point: what reaches the point from it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SourceLight {
+    /// Unit direction from the point toward the sample.
+    pub dir: DVec3,
+    /// Solid angle the sample stands for.
+    pub omega: f64,
+    /// Radiance arriving along the shadow ray (the source's, through whatever transmits).
+    pub value: [f64; 3],
+}
+
+impl Tracer {
+    /// Every light-source sample from `p` (as Radiance's `srcray` loop): its direction, solid
+    /// angle and the radiance its shadow ray brings back (zero when blocked). mkillum's
+    /// `l+` adds these to its distribution. Random numbers (source jitter) come from the
+    /// stream of `ray_index`.
+    pub fn source_light(&self, ray_index: u64, p: DVec3) -> Vec<SourceLight> {
+        let mut cx = self.ctx(ray_index, &[], None, None);
+        let r = Self::primary(p, DVec3::Z);
+        let mut out = Vec::new();
+        for si in 0..self.sources.len() {
+            self.each_sample(si, p, None, 1.0, &mut cx, |cx, s| {
+                let aim = Aim {
+                    l: s.l,
+                    tmax: s.tmax,
+                    si,
+                };
+                let c = self.shadow_ray(&r, Origin::at(p, None), aim, DVec3::ONE);
+                let v = self.trace(&c, cx);
+                out.push(SourceLight {
+                    dir: s.l,
+                    omega: s.omega,
+                    value: v.to_array(),
+                });
+            });
+        }
+        self.count(&cx);
+        out
+    }
+}

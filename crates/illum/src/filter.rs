@@ -1,0 +1,370 @@
+//! The scene filter: reads scene text (comments, `#@mkillum` lines, `!commands`,
+//! primitives), converts the selected surfaces and writes everything to the current
+//! output (standard output, or the file an `o=` directive names).
+
+use std::io::Write;
+
+use anyhow::{bail, Context, Result};
+use fenestra_trace::Tracer;
+
+use crate::directives::Settings;
+use crate::geometry::{Face, Ring};
+use crate::sample::{self, Job};
+use crate::write::{self, Prim};
+
+/// Where output goes.
+enum Sink {
+    Stdout(std::io::Stdout),
+    File(fenestra_cli::output::AtomicFile),
+}
+
+impl Sink {
+    fn write(&mut self, s: &str) -> Result<()> {
+        match self {
+            Sink::Stdout(o) => o.write_all(s.as_bytes())?,
+            Sink::File(f) => f.write_all(s.as_bytes())?,
+        }
+        Ok(())
+    }
+
+    fn finish(self) -> Result<()> {
+        match self {
+            Sink::Stdout(mut o) => o.flush()?,
+            Sink::File(f) => f.commit()?,
+        }
+        Ok(())
+    }
+}
+
+/// One surface's standard errors (`-E`): its name and per-direction errors.
+#[derive(Debug, Clone)]
+pub struct SurfaceError {
+    /// The surface.
+    pub name: String,
+    /// Mean radiance (luminance) over the directions.
+    pub mean: f64,
+    /// Standard error of each direction's luminance, relative to the mean.
+    pub rel: Vec<f64>,
+}
+
+/// A callback run after each converted surface (given its name).
+pub type SurfaceHook<'a> = Box<dyn FnMut(&str) + 'a>;
+
+/// The filter's state over a run.
+pub struct Filter<'a> {
+    tracer: &'a Tracer,
+    /// Directives in effect.
+    pub settings: Settings,
+    seed: u64,
+    header: String,
+    done_header: bool,
+    sink: Option<Sink>,
+    surfaces: u64,
+    /// Called after each converted surface (progress).
+    pub on_surface: Option<SurfaceHook<'a>>,
+    /// Per-surface standard errors, collected when `Some`.
+    pub errors: Option<Vec<SurfaceError>>,
+}
+
+fn warn(msg: impl std::fmt::Display) {
+    fenestra_cli::warn(msg);
+}
+
+impl<'a> Filter<'a> {
+    /// A filter over `tracer`; `header` is the command line printed before the first output.
+    pub fn new(tracer: &'a Tracer, seed: u64, header: String) -> Self {
+        Filter {
+            tracer,
+            settings: Settings::default(),
+            seed,
+            header,
+            done_header: false,
+            sink: Some(Sink::Stdout(std::io::stdout())),
+            surfaces: 0,
+            on_surface: None,
+            errors: None,
+        }
+    }
+
+    fn emit(&mut self, s: &str) -> Result<()> {
+        self.sink.as_mut().expect("an output").write(s)
+    }
+
+    fn check_header(&mut self) -> Result<()> {
+        if !self.done_header {
+            self.done_header = true;
+            let h = format!("# {}\n#@mkillum !\n", self.header);
+            self.emit(&h)?;
+        }
+        Ok(())
+    }
+
+    /// Finishes the output (commits an `o=` file).
+    pub fn finish(mut self) -> Result<()> {
+        if let Some(s) = self.sink.take() {
+            s.finish()?;
+        }
+        Ok(())
+    }
+
+    /// Filters scene text read from `name` (a file, "standard input" or a `!command`).
+    pub fn run_text(&mut self, text: &str, name: &str) -> Result<()> {
+        if text.as_bytes().contains(&0) || text.starts_with("#?RADIANCE") {
+            bail!("({name}): not scene text (an octree or binary file?); mkillum reads the surfaces to convert as Radiance scene text");
+        }
+        let mut pos = 0;
+        let bytes = text.as_bytes();
+        while pos < bytes.len() {
+            let c = bytes[pos];
+            if c.is_ascii_whitespace() {
+                pos += 1;
+                continue;
+            }
+            let line_end = text[pos..].find('\n').map_or(text.len(), |k| pos + k + 1);
+            if c == b'#' {
+                let line = &text[pos..line_end];
+                pos = line_end;
+                self.options(line, name)?;
+                continue;
+            }
+            if c == b'!' {
+                let cmd = text[pos + 1..line_end].trim_end();
+                pos = line_end;
+                let out = fenestra_cfmt::sh_c(cmd)
+                    .stderr(std::process::Stdio::inherit())
+                    .output()
+                    .with_context(|| format!("cannot execute \"!{cmd}\""))?;
+                let sub = String::from_utf8_lossy(&out.stdout).into_owned();
+                self.run_text(&sub, &format!("!{cmd}"))?;
+                if !out.status.success() {
+                    warn(format!("bad status from \"!{cmd}\""));
+                }
+                continue;
+            }
+            pos = self.object(text, pos, name)?;
+        }
+        Ok(())
+    }
+
+    fn options(&mut self, line: &str, name: &str) -> Result<()> {
+        let is_ours = line.starts_with("#@mkillum")
+            && line[9..].starts_with(|c: char| c.is_ascii_whitespace());
+        if !is_ours {
+            let mut l = line.to_string();
+            if !l.ends_with('\n') {
+                l.push('\n');
+            }
+            return self.emit(&l);
+        }
+        let fx = self.settings.apply(&line[10..]);
+        if fx.processed {
+            warn(format!("({name}): already processed!"));
+            return Ok(());
+        }
+        for w in &fx.warnings {
+            warn(w);
+        }
+        if let Some(o) = fx.output {
+            let f = fenestra_cli::output::AtomicFile::create(&o)
+                .with_context(|| format!("cannot open output file \"{o}\""))?;
+            if let Some(old) = self.sink.replace(Sink::File(f)) {
+                old.finish()?;
+            }
+            self.done_header = false;
+        }
+        self.check_header()?;
+        let body = line[2..].trim_end_matches(['\n', '\r']);
+        if fx.errors > 0 {
+            warn(format!(
+                "({name}): {} error(s) in option line: {}",
+                fx.errors,
+                line.trim_end()
+            ));
+            let e = format!(
+                "# {}: the following option line has {} error(s):\n",
+                fenestra_cli::prog(),
+                fx.errors
+            );
+            self.emit(&e)?;
+        }
+        let c = format!("# {body}\n");
+        self.emit(&c)
+    }
+
+    /// Reads and handles one primitive starting at `pos`; returns the position after it.
+    fn object(&mut self, text: &str, mut pos: usize, name: &str) -> Result<usize> {
+        let start = pos;
+        let line = || text[..start].matches('\n').count() + 1;
+        let mut word = |what: &str| -> Result<String> {
+            let rest = &text[pos..];
+            let skip = rest.len() - rest.trim_start().len();
+            let rest = &rest[skip..];
+            let end = rest.find(char::is_whitespace).unwrap_or(rest.len());
+            if end == 0 {
+                bail!(
+                    "({name}): error reading input (line {}: expected {what})",
+                    text[..start].matches('\n').count() + 1
+                );
+            }
+            pos += skip + end;
+            Ok(rest[..end].to_string())
+        };
+        let modifier = word("a modifier")?;
+        let ptype = word("a primitive type")?;
+        if ptype == "alias" {
+            let new = word("the alias name")?;
+            let target = word("the aliased modifier")?;
+            self.check_header()?;
+            let s = format!("\n{modifier} alias {new}\t{target}\n");
+            self.emit(&s)?;
+            return Ok(pos);
+        }
+        if fenestra_scene::types::rule(&ptype).is_none() {
+            bail!("({name}): unknown type \"{ptype}\" (line {})", line());
+        }
+        let id = word("a primitive name")?;
+        let count = |w: String, what: &str| -> Result<usize> {
+            match w.parse::<usize>() {
+                Ok(n) if n <= 1 << 20 => Ok(n),
+                _ => bail!(
+                    "({name}): error reading input (line {}: '{id}': expected the number of {what}, found '{w}')",
+                    line()
+                ),
+            }
+        };
+        let ns = count(word("a count")?, "string arguments")?;
+        let sargs = (0..ns)
+            .map(|_| word("a string argument"))
+            .collect::<Result<Vec<_>>>()?;
+        let ni = count(word("a count")?, "integer arguments")?;
+        let iargs = (0..ni)
+            .map(|_| word("an integer argument"))
+            .collect::<Result<Vec<_>>>()?;
+        let nr = count(word("a count")?, "real arguments")?;
+        let mut rargs = Vec::with_capacity(nr.min(4096));
+        for _ in 0..nr {
+            let w = word("a real argument")?;
+            match fenestra_cli::opts::parse_real(&w) {
+                Some(v) if v.is_finite() => rargs.push(v),
+                _ => bail!(
+                    "({name}): error reading input (line {}: '{id}': '{w}' is not a real number)",
+                    line()
+                ),
+            }
+        }
+        let p = Prim {
+            modifier,
+            ptype,
+            name: id,
+            sargs,
+            iargs,
+            rargs,
+        };
+        let doit =
+            self.settings.selects(&p.modifier) && fenestra_scene::types::is_surface(&p.ptype);
+        self.check_header()?;
+        let mut out = String::new();
+        if doit {
+            self.convert(&p, name, &mut out)?;
+        } else {
+            write::printobj(&mut out, &p.modifier, &p);
+        }
+        self.emit(&out)?;
+        Ok(pos)
+    }
+
+    fn pass_unchanged(&self, p: &Prim, out: &mut String, why: &str, name: &str) {
+        warn(format!("({name}): {why}"));
+        write::printobj(out, &p.modifier, p);
+    }
+
+    fn convert(&mut self, p: &Prim, name: &str, out: &mut String) -> Result<()> {
+        let il = &self.settings;
+        let (nalt, nazi) = match p.ptype.as_str() {
+            "sphere" => il.round_divisions(),
+            _ => il.flat_divisions(),
+        };
+        let nsamps = il.nsamps.max(1) as usize;
+        self.surfaces += 1;
+        let job = Job {
+            tracer: self.tracer,
+            seed: self.seed,
+            surface: self.surfaces,
+            nalt,
+            nazi,
+            nsamps,
+            light: il.light,
+        };
+        let (dist, axes) = match p.ptype.as_str() {
+            "polygon" => {
+                let face = Face::new(&p.rargs)
+                    .map_err(|e| anyhow::anyhow!("({name}): polygon \"{}\": {e}", p.name))?;
+                let Some(face) = face else {
+                    self.pass_unchanged(
+                        p,
+                        out,
+                        &format!("cannot make illum for polygon \"{}\" (zero area)", p.name),
+                        name,
+                    );
+                    return Ok(());
+                };
+                match sample::face(&job, &face) {
+                    Some(d) => (d, Some([face.u, face.v, face.norm])),
+                    None => {
+                        self.pass_unchanged(
+                            p,
+                            out,
+                            &format!("polygon \"{}\": bad aspect", p.name),
+                            name,
+                        );
+                        return Ok(());
+                    }
+                }
+            }
+            "ring" => {
+                let r = Ring::new(&p.rargs)
+                    .map_err(|e| anyhow::anyhow!("({name}): ring \"{}\": {e}", p.name))?;
+                (sample::ring(&job, &r), Some([r.u, r.v, r.axis]))
+            }
+            "sphere" => {
+                if p.rargs.len() != 4 {
+                    bail!("({name}): sphere \"{}\": bad # of arguments", p.name);
+                }
+                let c = glam::DVec3::new(p.rargs[0], p.rargs[1], p.rargs[2]);
+                (sample::sphere(&job, c, p.rargs[3]), None)
+            }
+            other => {
+                self.pass_unchanged(
+                    p,
+                    out,
+                    &format!("cannot make illum for {other} \"{}\"", p.name),
+                    name,
+                );
+                return Ok(());
+            }
+        };
+        let col = dist.average();
+        if let Some(f) = self.on_surface.as_mut() {
+            f(&p.name);
+        }
+        if crate::bright(col) <= self.settings.minbrt + 1e-6 {
+            write::printobj(out, &p.modifier, p);
+            return Ok(());
+        }
+        if let Some(errs) = self.errors.as_mut() {
+            let mean = crate::bright(col);
+            errs.push(SurfaceError {
+                name: p.name.clone(),
+                mean,
+                rel: dist.std_errors().iter().map(|e| e / mean).collect(),
+            });
+        }
+        if self.settings.sampdens > 0 {
+            write::distribution(out, &mut self.settings, &dist, col, axes)?;
+        } else if p.ptype == "sphere" {
+            warn(format!("sphere \"{}\": diffuse distribution", p.name));
+        }
+        write::illumout(out, &self.settings, &p.modifier, col, p);
+        Ok(())
+    }
+}

@@ -1,0 +1,302 @@
+//! Sampling a surface's distribution: for every direction bin, `s` rays shot through the
+//! surface from its front (room) side toward its back, whose radiance is what the illum
+//! will emit in the opposite direction. Bins are uniform in projected solid angle over
+//! the hemisphere (uniform in solid angle over a sphere). Every ray's random numbers and
+//! its tracer stream are keyed by the seed, the surface's number and the ray's index, so
+//! the result does not depend on the thread count.
+
+use fenestra_trace::rng::{spread2, Rng};
+use fenestra_trace::Tracer;
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::geometry::{perpendicular, Face, Ring};
+
+/// Radiance's relative origin offset (R_EPS).
+const R_EPS: f64 = 0.005;
+/// Radiance's FTINY.
+const FTINY: f64 = 1e-6;
+/// Rejection tries per origin before a sample gives up (counted against the surface's
+/// budget of 5 failures per ray, as Radiance's `nallow`).
+const MAX_TRIES: usize = 1000;
+
+/// Per-bin sums of sampled radiance.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Distribution {
+    /// Altitude divisions.
+    pub nalt: usize,
+    /// Azimuth divisions.
+    pub nazi: usize,
+    /// Rays per bin.
+    pub nsamps: usize,
+    /// Sum of the rays' RGB radiance per bin (`nalt × nazi`, altitude-major), direct
+    /// source samples (`l+`) included.
+    pub sums: Vec<[f64; 3]>,
+    /// Sum of squared luminance of the bin's sample rays (for the standard error).
+    pub sumsq: Vec<f64>,
+}
+
+impl Distribution {
+    fn new(nalt: usize, nazi: usize, nsamps: usize) -> Self {
+        Distribution {
+            nalt,
+            nazi,
+            nsamps,
+            sums: vec![[0.0; 3]; nalt * nazi],
+            sumsq: vec![0.0; nalt * nazi],
+        }
+    }
+
+    /// Mean radiance over the bins (each bin's mean over its rays).
+    pub fn average(&self) -> [f64; 3] {
+        let n = self.sums.len() as f64;
+        let s = self.nsamps.max(1) as f64;
+        let mut a = [0.0; 3];
+        for v in &self.sums {
+            for k in 0..3 {
+                a[k] += v[k];
+            }
+        }
+        a.map(|x| x / n / s)
+    }
+
+    /// Standard error of each bin's mean luminance (from its rays' spread).
+    pub fn std_errors(&self) -> Vec<f64> {
+        let s = self.nsamps as f64;
+        self.sums
+            .iter()
+            .zip(&self.sumsq)
+            .map(|(v, &q)| {
+                if self.nsamps < 2 {
+                    return 0.0;
+                }
+                let m = crate::bright(*v) / s;
+                let var = ((q / s - m * m) * s / (s - 1.0)).max(0.0);
+                (var / s).sqrt()
+            })
+            .collect()
+    }
+
+    fn add(&mut self, k: usize, v: [f64; 3]) {
+        for (s, x) in self.sums[k].iter_mut().zip(v) {
+            *s += x;
+        }
+        let b = crate::bright(v);
+        self.sumsq[k] += b * b;
+    }
+}
+
+/// A unit direction uniform in projected solid angle: `alt` is sin²θ, `azi` a turn fraction.
+fn flatdir(alt: f64, azi: f64) -> DVec3 {
+    let d1 = alt.max(0.0).sqrt();
+    let d2 = std::f64::consts::TAU * azi;
+    DVec3::new(d1 * d2.cos(), d1 * d2.sin(), (1.0 - alt).max(0.0).sqrt())
+}
+
+/// A unit direction uniform over the sphere: `alt` in [0,1] from +z to −z.
+fn rounddir(alt: f64, azi: f64) -> DVec3 {
+    let z = 1.0 - 2.0 * alt;
+    let d1 = (1.0 - z * z).max(0.0).sqrt();
+    let d2 = std::f64::consts::TAU * azi;
+    DVec3::new(d1 * d2.cos(), d1 * d2.sin(), z)
+}
+
+/// The bin of a local hemisphere direction (`z` toward the normal), as Radiance's
+/// `flatindex`: altitude by sin²θ, azimuth rounded to the nearest bin centre.
+pub fn flatindex(dv: DVec3, nalt: usize, nazi: usize) -> usize {
+    let d = 1.0 - dv.z * dv.z;
+    let i = ((d * nalt as f64) as usize).min(nalt - 1);
+    let mut a = dv.y.atan2(dv.x) * (0.5 / std::f64::consts::PI);
+    if a < 0.0 {
+        a += 1.0;
+    }
+    let mut j = (a * nazi as f64 + 0.5) as usize;
+    if j >= nazi {
+        j = 0;
+    }
+    i * nazi + j
+}
+
+/// What the sampler needs besides the surface.
+pub struct Job<'a> {
+    /// The tracer.
+    pub tracer: &'a Tracer,
+    /// Seed of the sampling streams.
+    pub seed: u64,
+    /// The surface's number in the run (keys its streams).
+    pub surface: u64,
+    /// Altitude and azimuth divisions.
+    pub nalt: usize,
+    /// Azimuth divisions.
+    pub nazi: usize,
+    /// Rays per bin.
+    pub nsamps: usize,
+    /// Add light sources explicitly (`l+`).
+    pub light: bool,
+}
+
+impl Job<'_> {
+    fn stream(&self, index: u64) -> (Rng, u64) {
+        let id = (self.surface << 36) | index;
+        (Rng::for_ray(self.seed ^ 0x6d6b_696c_6c75_6d00, id), id)
+    }
+
+    /// Direction of sample `i` of bin `k` in local coordinates (toward the normal).
+    fn local_dir(&self, k: usize, i: usize, rng: &mut Rng) -> DVec3 {
+        let t = (i as f64 + rng.next_f64()) / self.nsamps as f64;
+        let (s0, s1) = spread2(t, rng);
+        let alti = k / self.nazi;
+        let r1 = (alti as f64 + s0) / self.nalt as f64;
+        let r2 = ((k - alti * self.nazi) as f64 + s1 - 0.5) / self.nazi as f64;
+        flatdir(r1, r2)
+    }
+
+    /// Adds the light sources seen from `org` to the bins of their reversed directions.
+    fn add_sources(&self, dist: &mut Distribution, id: u64, org: DVec3, axes: [DVec3; 3]) {
+        let [u, v, w] = axes;
+        let scale = (self.nalt * self.nazi) as f64 / std::f64::consts::PI;
+        for s in self.tracer.source_light(id, org) {
+            let l = DVec3::new(s.dir.dot(u), s.dir.dot(v), s.dir.dot(w));
+            if l.z >= -FTINY {
+                continue;
+            }
+            let l = -l;
+            let k = flatindex(l, self.nalt, self.nazi);
+            let d = scale * l.z * s.omega;
+            for c in 0..3 {
+                dist.sums[k][c] += s.value[c] * d;
+            }
+        }
+    }
+}
+
+/// A polygon's distribution; `None` when origins could not be placed ("bad aspect").
+pub fn face(job: &Job, f: &Face) -> Option<Distribution> {
+    let n = job.nalt * job.nazi;
+    let s = job.nsamps;
+    let eps = R_EPS * f.area.sqrt();
+    let origin = |rng: &mut Rng| -> (Option<DVec3>, usize) {
+        for t in 0..MAX_TRIES {
+            let a = f.ur[0] + (f.ur[1] - f.ur[0]) * rng.next_f64();
+            let b = f.vr[0] + (f.vr[1] - f.vr[0]) * rng.next_f64();
+            if f.contains(a, b) {
+                return (Some(f.point(a, b)), t);
+            }
+        }
+        (None, MAX_TRIES)
+    };
+    let rays: Vec<(usize, [f64; 3], usize)> = (0..n * s)
+        .into_par_iter()
+        .map(|idx| {
+            let (k, i) = (idx / s, idx % s);
+            let (mut rng, id) = job.stream(idx as u64);
+            let dn = job.local_dir(k, i, &mut rng);
+            let dir = -(dn.x * f.u + dn.y * f.v + dn.z * f.norm);
+            let (org, fails) = origin(&mut rng);
+            match org {
+                Some(o) => (k, job.tracer.radiance(id, o - eps * dir, dir), fails),
+                None => (k, [0.0; 3], fails),
+            }
+        })
+        .collect();
+    let fails: usize = rays.iter().map(|r| r.2).sum();
+    if fails > 5 * n * s {
+        return None;
+    }
+    let mut dist = Distribution::new(job.nalt, job.nazi, s);
+    for (k, v, _) in rays {
+        dist.add(k, v);
+    }
+    if job.light {
+        for i in 0..s {
+            let (mut rng, id) = job.stream((n * s + i) as u64);
+            let (org, _) = origin(&mut rng);
+            let org = org?;
+            job.add_sources(&mut dist, id, org, [f.u, f.v, f.norm]);
+        }
+    }
+    Some(dist)
+}
+
+/// A ring's distribution.
+pub fn ring(job: &Job, r: &Ring) -> Distribution {
+    let n = job.nalt * job.nazi;
+    let s = job.nsamps;
+    let eps = R_EPS * r.r1;
+    let rays: Vec<(usize, [f64; 3])> = (0..n * s)
+        .into_par_iter()
+        .map(|idx| {
+            let (k, i) = (idx / s, idx % s);
+            let (mut rng, id) = job.stream(idx as u64);
+            let dn = job.local_dir(k, i, &mut rng);
+            let dir = -(dn.x * r.u + dn.y * r.v + dn.z * r.axis);
+            let org = r.point(rng.next_f64(), rng.next_f64()) + eps * r.axis;
+            (k, job.tracer.radiance(id, org, dir))
+        })
+        .collect();
+    let mut dist = Distribution::new(job.nalt, job.nazi, s);
+    for (k, v) in rays {
+        dist.add(k, v);
+    }
+    if job.light {
+        for i in 0..s {
+            let (mut rng, id) = job.stream((n * s + i) as u64);
+            let org = r.point(rng.next_f64(), rng.next_f64());
+            job.add_sources(&mut dist, id, org, [r.u, r.v, r.axis]);
+        }
+    }
+    dist
+}
+
+/// A sphere's distribution (centre and radius), over the whole sphere in world axes.
+pub fn sphere(job: &Job, centre: DVec3, radius: f64) -> Distribution {
+    let n = job.nalt * job.nazi;
+    let s = job.nsamps;
+    let rays: Vec<(usize, [f64; 3])> = (0..n * s)
+        .into_par_iter()
+        .map(|idx| {
+            let (k, i) = (idx / s, idx % s);
+            let (mut rng, id) = job.stream(idx as u64);
+            let t = (i as f64 + rng.next_f64()) / s as f64;
+            let (s0, s1) = spread2(t, &mut rng);
+            let (a, z) = (k / job.nazi, k % job.nazi);
+            let out = rounddir(
+                (a as f64 + s0) / job.nalt as f64,
+                (z as f64 + s1 - 0.5) / job.nazi as f64,
+            );
+            let u = perpendicular(out);
+            let v = out.cross(u);
+            let r3 = rng.next_f64().sqrt();
+            let ph = std::f64::consts::TAU * rng.next_f64();
+            let org = centre
+                + r3 * radius * ph.cos() * u
+                + r3 * radius * ph.sin() * v
+                + radius * (1.01 - r3 * r3).sqrt() * out;
+            (k, job.tracer.radiance(id, org, -out))
+        })
+        .collect();
+    let mut dist = Distribution::new(job.nalt, job.nazi, s);
+    for (k, v) in rays {
+        dist.add(k, v);
+    }
+    dist
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn flatindex_inverts_the_bins() {
+        let (nalt, nazi) = (10, 31);
+        let mut rng = Rng::for_ray(1, 2);
+        for k in 0..nalt * nazi {
+            for _ in 0..20 {
+                let alti = k / nazi;
+                let r1 = (alti as f64 + rng.next_f64()) / nalt as f64;
+                let r2 = ((k - alti * nazi) as f64 + rng.next_f64() - 0.5) / nazi as f64;
+                assert_eq!(flatindex(flatdir(r1, r2), nalt, nazi), k);
+            }
+        }
+    }
+}

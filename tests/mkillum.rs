@@ -1,0 +1,391 @@
+//! mkillum: directive handling and output layout against the oracle's live mkillum, the
+//! reference window (Radiance's stored distributions and proxy renderings), thread-count
+//! independence and bad input.
+
+mod common;
+
+use std::path::Path;
+use std::process::Command;
+
+fn fx(name: &str) -> String {
+    common::fixture("mkillum").join(name).display().to_string()
+}
+
+/// Replaces every number in `text` by `N` (layout comparison).
+fn mask_numbers(text: &str) -> String {
+    let mut out = String::new();
+    let mut chars = text.chars().peekable();
+    let mut prev_word = false;
+    while let Some(c) = chars.next() {
+        let starts_number = (c.is_ascii_digit() || c == '-' || c == '.')
+            && !prev_word
+            && (c.is_ascii_digit()
+                || chars
+                    .peek()
+                    .is_some_and(|d| d.is_ascii_digit() || *d == '.'));
+        if starts_number {
+            while chars
+                .peek()
+                .is_some_and(|d| d.is_ascii_alphanumeric() || "+-.".contains(*d))
+            {
+                chars.next();
+            }
+            out.push('N');
+            prev_word = true;
+            continue;
+        }
+        prev_word = c.is_ascii_alphanumeric() || c == '_';
+        out.push(c);
+    }
+    out
+}
+
+/// The `3 r g b` colour lines of an mkillum output, in order.
+fn colours(text: &str) -> Vec<[f64; 3]> {
+    text.lines()
+        .filter_map(|l| {
+            let w: Vec<&str> = l.split_whitespace().collect();
+            (w.len() == 4 && w[0] == "3" && text.contains("illum"))
+                .then(|| [w[1], w[2], w[3]].map(|x| x.parse::<f64>().unwrap_or(f64::NAN)))
+        })
+        .collect()
+}
+
+fn ours(dir: &Path) -> Command {
+    let mut c = common::fenestra("mkillum");
+    c.current_dir(dir);
+    c.env(
+        "RAYPATH",
+        format!(".:{}", common::fixture("threephase").display()),
+    );
+    c
+}
+
+const SKY: &str = "void glow skyglow 0 0 4 2 2.5 3 0\nskyglow source sky 0 0 4 0 0 1 180\n\
+                   void glow groundglow 0 0 4 .5 .4 .3 0\ngroundglow source ground 0 0 4 0 0 -1 180\n";
+
+const CANDIDATES: &str = "# candidates\nvoid plastic wall 0 0 5 .5 .5 .5 0 0\n\
+#@mkillum i=void c=a d=4 s=8 f=wdist\n\
+void polygon up_window 0 0 12 0 0 1  0 1 1  1 1 1  1 0 1\n\
+#@mkillum c=d d=10 s=4 m=side\n\
+void polygon side_window 0 0 12 0 0 0 0 0 1 1 0 1 1 0 0\n\
+#@mkillum c=n d=0 q=4 l+x\n\
+void ring roof_ring 0 0 8 0 0 3 0 0 -1 0 0.5\n\
+#@mkillum e=void b=100\n\
+wall polygon dim 0 0 9 0 0 5 1 0 5 0 1 5\n\
+#@mkillum a d=3 s=4\n\
+wall sphere ball 0 0 4 0 0 10 0.5\n\
+wall cylinder tube 0 0 7 0 0 0 0 0 1 0.1\n\
+void polygon flat 0 0 9 0 0 0 1 0 0 2 0 0\n\
+wall alias wall2 wall\n\
+#@mkillum n\n\
+void polygon passed 0 0 9 0 0 0 1 0 0 1 1 0\n";
+
+#[test]
+fn oracle_directives_and_layout() {
+    // Every directive kind (i= e= a n c=a/d/n d= d=0 s= m= f= b= l+, two bad ones), a
+    // polygon, a ring, a sphere, a cylinder (not convertible), a zero-area polygon, an
+    // alias and void surfaces, under a sky and a ground glow (-ab 0: each ray returns the
+    // glow it meets). Output text must be identical with the numbers masked, the same data
+    // files must be written, and the averages agree: exactly (1e-5) where every ray sees
+    // one glow (the up window, 2 2.5 3), within 1e-4 for the ring (both 2.3998..), and within 10% for the
+    // side window, half sky half ground: its ~6 bins straddling the horizon split their 4
+    // rays between sky and ground at random in Radiance (unseeded), so the sky fraction
+    // has an sd of about sqrt(6*4/4)/108 = 2.3%, 3.3% of the average: 10% is 3 sd. Two
+    // oracle runs gave 1.208 and 1.278 (green 1.392, 1.489) against the exact 1.25 1.45
+    // 1.65, which ours reproduces (its strata split each such bin evenly).
+    let Some(o) = common::oracle() else { return };
+    let root = common::scratch("mkillum-directives");
+    let mut outs = Vec::new();
+    for side in ["theirs", "ours"] {
+        let d = root.join(side);
+        std::fs::create_dir_all(&d).unwrap();
+        std::fs::write(d.join("scene.rad"), SKY).unwrap();
+        let (mut oconv, mut mk) = if side == "theirs" {
+            (o.command("oconv"), o.command("mkillum"))
+        } else {
+            (common::fenestra("oconv"), ours(&d))
+        };
+        let oct = common::run_ok(oconv.arg("scene.rad").current_dir(&d));
+        std::fs::write(d.join("s.oct"), oct).unwrap();
+        mk.args(["-ab", "0", "s.oct"]).current_dir(&d);
+        let out = common::run_stdin(mk, CANDIDATES.as_bytes());
+        assert!(
+            out.status.success(),
+            "{side}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let err = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert!(err.contains("2 error(s) in option line"), "{side}: {err}");
+        assert!(
+            err.contains("cannot make illum for cylinder \"tube\""),
+            "{side}: {err}"
+        );
+        outs.push(String::from_utf8(out.stdout).unwrap());
+    }
+    assert_eq!(mask_numbers(&outs[0]), mask_numbers(&outs[1]));
+    for f in ["wdist.dat", "wdistR1.dat", "wdistG1.dat", "wdistB1.dat"] {
+        assert!(root.join("ours").join(f).exists(), "{f}");
+        assert!(root.join("theirs").join(f).exists(), "{f}");
+    }
+    let (a, b) = (colours(&outs[1]), colours(&outs[0]));
+    // up window, side window, ring; the sphere stays as it was (b=100 still applies)
+    assert_eq!(a.len(), 3, "{a:?}");
+    assert_eq!(a.len(), b.len());
+    let tol = [1e-5, 0.10, 1e-4];
+    for ((x, y), t) in a.iter().zip(&b).zip(tol) {
+        for k in 0..3 {
+            assert!((x[k] / y[k] - 1.0).abs() <= t, "{x:?} vs {y:?}");
+        }
+    }
+    // the up window's distribution is uniform: both files are all ones
+    let up = std::fs::read_to_string(root.join("ours/wdist.dat")).unwrap();
+    assert_eq!(
+        up,
+        std::fs::read_to_string(root.join("theirs/wdist.dat")).unwrap()
+    );
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+/// Values of a data file (dimensions, values).
+fn datafile(path: &Path) -> (Vec<(f64, f64, usize)>, Vec<f64>) {
+    let t = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let w: Vec<&str> = t.split_whitespace().collect();
+    let nd: usize = w[0].parse().unwrap();
+    let mut dims = Vec::new();
+    for k in 0..nd {
+        dims.push((
+            w[1 + 3 * k].parse().unwrap(),
+            w[2 + 3 * k].parse().unwrap(),
+            w[3 + 3 * k].parse().unwrap(),
+        ));
+    }
+    let vals = w[1 + 3 * nd..].iter().map(|x| x.parse().unwrap()).collect();
+    (dims, vals)
+}
+
+/// The `-E` file's relative standard errors of the first surface.
+fn rel_errors(path: &Path) -> Vec<f64> {
+    let t = std::fs::read_to_string(path).unwrap();
+    t.lines()
+        .nth(2)
+        .unwrap()
+        .split_whitespace()
+        .map(|x| x.parse().unwrap())
+        .collect()
+}
+
+fn lux(text: &[u8]) -> Vec<f64> {
+    common::numbers(text)
+        .chunks(3)
+        .map(|c| 179.0 * (0.265 * c[0] + 0.670 * c[1] + 0.065 * c[2]))
+        .collect()
+}
+
+fn mean(v: &[f64]) -> f64 {
+    v.iter().sum::<f64>() / v.len() as f64
+}
+
+#[test]
+fn reference_glass_window_distribution_and_proxy() {
+    // The reference command (mkillum -n 2 -ab 2 -ad 1024 -aa 0 -lw 1e-4, #@mkillum i=void
+    // c=d d=100 s=32) on the glass window. Checks:
+    // - output text identical to Radiance's with the numbers masked; average colour within
+    //   1% (measured +0.1%);
+    // - every direction's relative value against Radiance's file within 4 sd, the sd of a
+    //   difference of two estimates: our per-direction standard error (-E, from the spread
+    //   of its 32 rays) times sqrt 2, combined with a one-ray floor value/32 (a ray that
+    //   meets a rare feature such as the window jamb moves a bin by 1/32, an event one
+    //   realisation may miss: it leaves the spread at ~0). Measured: largest 2.6 sd;
+    // - the sensors rendered with our proxy (our rtrace, -ab 5 -ad 8192) against Radiance's
+    //   proxy rendering: mean within 2% (measured +0.4%), each sensor within 8% (Radiance's
+    //   own proxy vs no-proxy: mean |difference| 4.4%, max 8.3%; measured: 3.4%).
+    let dir = common::scratch("mkillum-glass");
+    let scene: Vec<String> = [
+        "materials.rad",
+        "room.rad",
+        "exterior.rad",
+        "window_glass.rad",
+        "sky.rad",
+        "skyfunc_glow.rad",
+    ]
+    .iter()
+    .map(|f| fx(f))
+    .collect();
+    let mut oconv = common::fenestra("oconv");
+    oconv.args(&scene);
+    std::fs::write(dir.join("scene.oct"), common::run_ok(&mut oconv)).unwrap();
+    let mut mk = ours(&dir);
+    mk.args([
+        "-n",
+        "2",
+        "-E",
+        "err.txt",
+        "-ab",
+        "2",
+        "-ad",
+        "1024",
+        "-aa",
+        "0",
+        "-lw",
+        "1e-4",
+        "scene.oct",
+        "<",
+    ])
+    .arg(fx("window_illum_glass.rad"));
+    let out = String::from_utf8(common::run_ok(&mut mk)).unwrap();
+    let theirs = std::fs::read_to_string(fx("illum_glass.rad")).unwrap();
+    // the header names the command: compare from the directive line on
+    let from = |t: &str| t[t.find("#@mkillum !").unwrap()..].to_string();
+    assert_eq!(mask_numbers(&from(&out)), mask_numbers(&from(&theirs)));
+    let (a, b) = (colours(&out)[0], colours(&theirs)[0]);
+    for k in 0..3 {
+        assert!((a[k] / b[k] - 1.0).abs() < 0.01, "{a:?} vs {b:?}");
+    }
+    let rel = rel_errors(&dir.join("err.txt"));
+    for ch in ["R", "G", "B"] {
+        let (da, va) = datafile(&dir.join(format!("ill_glass{ch}.dat")));
+        let (db, vb) = datafile(Path::new(&fx(&format!("ill_glass{ch}.dat"))));
+        assert_eq!(da, db);
+        let m = da[1].2;
+        let mut worst = 0.0f64;
+        for r in 1..da[0].2 {
+            for c in 0..m - 1 {
+                let (x, y) = (va[r * m + c], vb[r * m + c]);
+                let se = rel[(r - 1) * (m - 1) + c];
+                let sd = (2.0 * se * se + (x.max(y) / 32.0).powi(2)).sqrt();
+                worst = worst.max((x - y).abs() / sd);
+            }
+        }
+        assert!(
+            worst < 4.0,
+            "{ch}: a direction {worst:.2} sd from Radiance's"
+        );
+    }
+    // render the sensors through the proxy
+    std::fs::write(dir.join("illum_glass.rad"), &out).unwrap();
+    let mut oconv = common::fenestra("oconv");
+    oconv
+        .arg("-f")
+        .args(&scene)
+        .arg("illum_glass.rad")
+        .current_dir(&dir);
+    std::fs::write(dir.join("proxy.oct"), common::run_ok(&mut oconv)).unwrap();
+    let mut rt = common::fenestra("rtrace");
+    rt.args([
+        "-n",
+        "2",
+        "-h",
+        "-I+",
+        "-ab",
+        "5",
+        "-ad",
+        "8192",
+        "-aa",
+        "0",
+        "-lw",
+        "1e-5",
+        "proxy.oct",
+    ])
+    .current_dir(&dir)
+    .env("RAYPATH", ".");
+    let pts = std::fs::read(fx("sensors.pts")).unwrap();
+    let r = common::run_stdin(rt, &pts);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let mine = lux(&r.stdout);
+    let rad = lux(&std::fs::read(fx("irr_glass_proxy.dat")).unwrap());
+    assert_eq!(mine.len(), rad.len());
+    assert!((mean(&mine) / mean(&rad) - 1.0).abs() < 0.02);
+    for (x, y) in mine.iter().zip(&rad) {
+        assert!((x / y - 1.0).abs() < 0.08, "{x} vs {y}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn same_output_for_any_thread_count() {
+    let root = common::scratch("mkillum-threads");
+    let mut texts = Vec::new();
+    for n in ["1", "2"] {
+        let d = root.join(n);
+        std::fs::create_dir_all(&d).unwrap();
+        std::fs::write(
+            d.join("scene.rad"),
+            format!("{SKY}void plastic grey 0 0 5 .5 .5 .5 0 0\ngrey polygon box 0 0 12 -1 -1 2 1 -1 2 1 1 2 -1 1 2\n"),
+        )
+        .unwrap();
+        let mut mk = ours(&d);
+        mk.args(["-n", n, "-ab", "1", "-ad", "32", "scene.rad"]);
+        let out = common::run_stdin(
+            mk,
+            b"#@mkillum c=d d=6 s=6\nvoid polygon w 0 0 12 0 0 0 0 0.5 0 0.5 0.5 0 0.5 0 0\n",
+        );
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let mut all = out.stdout.clone();
+        for f in ["illumR.dat", "illumG.dat", "illumB.dat"] {
+            all.extend(std::fs::read(d.join(f)).unwrap());
+        }
+        texts.push(all);
+    }
+    let strip = |t: &[u8]| -> Vec<u8> {
+        let s = String::from_utf8_lossy(t);
+        s.lines()
+            .filter(|l| !l.starts_with("# "))
+            .collect::<Vec<_>>()
+            .join("\n")
+            .into_bytes()
+    };
+    assert_eq!(strip(&texts[0]), strip(&texts[1]));
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+#[test]
+fn bad_input_is_reported_clearly() {
+    let dir = common::scratch("mkillum-bad");
+    std::fs::write(dir.join("scene.rad"), SKY).unwrap();
+    let run = |input: &[u8]| {
+        let mut mk = ours(&dir);
+        mk.args(["-ab", "0", "scene.rad"]);
+        common::run_stdin(mk, input)
+    };
+    // an unknown directive: echoed with the error count, the rest still processed
+    let out = run(b"#@mkillum q=1 d=4 s=2\nvoid polygon w 0 0 9 0 0 0 1 0 0 0 1 0\n");
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("# mkillum: the following option line has 1 error(s):"),
+        "{text}"
+    );
+    assert!(text.contains("illum illum_mat"), "{text}");
+    // a zero-area polygon: warned about and passed through
+    let out = run(b"#@mkillum d=4 s=2\nglass_mat polygon z 0 0 9 0 0 0 1 0 0 2 0 0\n");
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("cannot make illum for polygon \"z\""));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("glass_mat polygon z"));
+    // an octree as input
+    let mut oconv = common::fenestra("oconv");
+    oconv.arg("scene.rad").current_dir(&dir);
+    let oct = common::run_ok(&mut oconv);
+    let out = run(&oct);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("not scene text"));
+    // a truncated primitive names the line
+    let out = run(b"#@mkillum d=4\n\nvoid polygon w 0 0 9 0 0\n");
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("line 3"), "{err}");
+    // an unknown type
+    let out = run(b"void polygonn w 0 0 9 0 0 0 1 0 0 0 1 0\n");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("unknown type \"polygonn\""));
+    // a missing input file after '<'
+    let mut mk = ours(&dir);
+    mk.args(["scene.rad", "<", "missing.rad"]);
+    let out = mk.output().unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("missing.rad"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
