@@ -585,6 +585,99 @@ fn encode_all<'a>(b: &'a Bsdf, rng: &mut Drand48) -> [Slot<'a>; 4] {
     })
 }
 
+/// A Klems component as Radiance's renderer holds it after loading: the Lambertian part split
+/// off (RGB and Y, BSDF values in sr⁻¹) and the remainder (Y per element, `o·n_in + i`,
+/// negatives as zero; `None` when Radiance drops it) with each remainder element's RGB
+/// (`None` for a grey component).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderComponent {
+    /// RGB of the Lambertian part (sr⁻¹).
+    pub lambertian: [f64; 3],
+    /// CIE Y of the Lambertian part (sr⁻¹).
+    pub lambertian_y: f64,
+    /// The non-diffuse remainder's Y.
+    pub remainder: Option<KlemsMatrix>,
+    /// The remainder's RGB per element (same order as its values).
+    pub rgb: Option<Vec<[f64; 3]>>,
+}
+
+/// The four components of `b` as Radiance's renderer loads them (colour dither from a fresh
+/// generator), in Radiance's rf rb tf tb order (XML `Reflection Back`, `Reflection Front`,
+/// `Transmission Back`, `Transmission Front`); `None` where there is no Klems block. Colour
+/// blocks on another basis than the Y block are ignored (grey).
+pub fn render_components(b: &Bsdf) -> [Option<RenderComponent>; 4] {
+    let slots = encode_all(b, &mut Drand48::default());
+    let mut out: [Option<RenderComponent>; 4] = [None, None, None, None];
+    for (k, slot) in slots.into_iter().enumerate() {
+        let y = match &slot {
+            Slot::Klems(c) => c.y,
+            Slot::BadBasis => match b.klems(ENCODE_ORDER[k], &Wavelength::Visible) {
+                Some(y) => y,
+                None => continue,
+            },
+            _ => continue,
+        };
+        let colour = match &slot {
+            Slot::Klems(c) => c.colour.as_ref().map(|col| (c, col)),
+            _ => None,
+        };
+        out[k] = Some(match colour {
+            None => {
+                let (lamb, keep) = lambertian_split(y);
+                let remainder = keep.then(|| {
+                    let mut r = y.clone();
+                    for v in &mut r.values {
+                        *v = (*v - lamb).max(0.0);
+                    }
+                    r
+                });
+                RenderComponent {
+                    lambertian: [lamb; 3],
+                    lambertian_y: lamb,
+                    remainder,
+                    rgb: None,
+                }
+            }
+            Some((c, col)) => {
+                let (_, keep) = c.split();
+                let split = col.remainder.is_some();
+                let rest: Vec<f64> = col
+                    .remainder
+                    .clone()
+                    .unwrap_or_else(|| y.values.clone())
+                    .into_iter()
+                    .map(|v| v.max(0.0))
+                    .collect();
+                let rgb: Vec<[f64; 3]> = rest
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &yr)| {
+                        if yr <= 0.0 {
+                            return [0.0; 3];
+                        }
+                        match chroma_xyz(col.chroma[k], yr) {
+                            Some(xyz) => clip_gamut(mul3(&c.m, xyz), yr),
+                            None => [yr; 3],
+                        }
+                    })
+                    .collect();
+                let remainder = keep.then(|| {
+                    let mut r = y.clone();
+                    r.values = rest;
+                    r
+                });
+                RenderComponent {
+                    lambertian: if split { col.lambertian } else { [0.0; 3] },
+                    lambertian_y: if split { col.lambertian_xyz[1] } else { 0.0 },
+                    rgb: remainder.as_ref().map(|_| rgb),
+                    remainder,
+                }
+            }
+        });
+    }
+    out
+}
+
 /// Component `d` out of [`encode_all`]'s result.
 fn take<'a>(slots: &mut [Slot<'a>; 4], d: Direction) -> Result<Option<Component<'a>>, MatrixError> {
     let k = ENCODE_ORDER.iter().position(|&e| e == d).unwrap_or(0);

@@ -21,6 +21,10 @@ use glam::DVec3;
 #[derive(Debug)]
 pub struct Component {
     m: KlemsMatrix,
+    /// Per element (`o·n_in + i`): RGB over Y of a coloured file's element (`None`: grey).
+    colour: Option<Vec<[f32; 3]>>,
+    /// Per incident patch: Σ RGB·λ over outgoing patches (the coloured hemispherical total).
+    hemi_rgb: Vec<DVec3>,
     /// Per incident patch: cumulative BSDF·λ over outgoing patches.
     cdf: Vec<Vec<f64>>,
     /// Whether the outgoing side is the back (−Z) side.
@@ -108,16 +112,33 @@ impl LobeData<'_> {
         }
     }
 
+    /// Directional-hemispherical total for view `v` in RGB (a grey lobe: the total in
+    /// every channel).
+    pub fn hemi_rgb(&self, v: DVec3) -> DVec3 {
+        match self {
+            LobeData::Klems(c) => c.hemi_rgb(v),
+            LobeData::Tree(..) => DVec3::splat(self.hemi(v)),
+        }
+    }
+
     /// A direction for view `v` drawn in proportion to the BSDF × projected solid angle,
-    /// with the view's hemispherical total.
-    pub fn sample(&self, v: DVec3, u: f64, u0: f64, u1: f64) -> Option<(DVec3, f64)> {
+    /// with the view's hemispherical total and the colour (RGB over Y) of the cell drawn.
+    pub fn sample(&self, v: DVec3, u: f64, u0: f64, u1: f64) -> Option<(DVec3, f64, DVec3)> {
         match self {
             LobeData::Klems(c) => c.sample(v, u, u0, u1),
             LobeData::Tree(t, lobe, front) => {
                 let s = t.slice(*lobe, *front, v.to_array())?;
                 let d = s.sample(u, u0, u1)?;
-                Some((DVec3::from(d), s.total()))
+                Some((DVec3::from(d), s.total(), DVec3::ONE))
             }
+        }
+    }
+
+    /// Colour (RGB over Y) of the cell of view `v` and light `l` (ones for a grey lobe).
+    pub fn colour(&self, v: DVec3, l: DVec3) -> DVec3 {
+        match self {
+            LobeData::Klems(c) => c.colour(v, l),
+            LobeData::Tree(..) => DVec3::ONE,
         }
     }
 
@@ -173,27 +194,13 @@ impl BsdfMat {
     }
 }
 
-/// A matrix split as Radiance's loader does: the non-diffuse remainder (if kept) and the
-/// hemispherical Lambertian part (π × the minimum split off).
-fn split(m: &KlemsMatrix) -> (Option<KlemsMatrix>, f64) {
-    let (lamb, keep) = fenestra_bsdf::radiance::lambertian_split(m);
-    let rest = keep.then(|| {
-        let mut r = m.clone();
-        for v in &mut r.values {
-            *v = (*v - lamb).max(0.0);
-        }
-        r
-    });
-    (rest, std::f64::consts::PI * lamb)
-}
-
 fn flip(v: DVec3, x: bool, z: bool) -> [f64; 3] {
     let s = if x { -1.0 } else { 1.0 };
     [s * v.x, s * v.y, if z { -v.z } else { v.z }]
 }
 
 impl Component {
-    fn new(m: KlemsMatrix, in_back: bool, out_back: bool) -> Component {
+    fn new(m: KlemsMatrix, rgb: Option<Vec<[f64; 3]>>, in_back: bool, out_back: bool) -> Component {
         let ni = m.incident.len();
         let lam: Vec<f64> = (0..m.outgoing.len())
             .map(|o| m.outgoing.projected_solid_angle(o).unwrap_or(0.0))
@@ -218,8 +225,36 @@ impl Component {
             .filter_map(|o| m.outgoing.projected_solid_angle(o))
             .chain((0..m.incident.len()).filter_map(|i| m.incident.projected_solid_angle(i)))
             .fold(f64::INFINITY, f64::min);
+        let hemi_rgb: Vec<DVec3> = match &rgb {
+            None => cdf
+                .iter()
+                .map(|c| DVec3::splat(c.last().copied().unwrap_or(0.0)))
+                .collect(),
+            Some(rgb) => (0..ni)
+                .map(|i| {
+                    lam.iter()
+                        .enumerate()
+                        .map(|(o, l)| DVec3::from(rgb[o * ni + i]) * *l)
+                        .sum()
+                })
+                .collect(),
+        };
+        let colour = rgb.map(|rgb| {
+            rgb.iter()
+                .zip(&m.values)
+                .map(|(c, &y)| {
+                    if y > 0.0 {
+                        [(c[0] / y) as f32, (c[1] / y) as f32, (c[2] / y) as f32]
+                    } else {
+                        [1.0; 3]
+                    }
+                })
+                .collect()
+        });
         Component {
             m,
+            colour,
+            hemi_rgb,
             cdf,
             out_back,
             in_back,
@@ -233,6 +268,29 @@ impl Component {
         self.in_index(v)
             .and_then(|i| self.cdf[i].last().copied())
             .unwrap_or(0.0)
+    }
+
+    /// The coloured hemispherical total for view `v`.
+    pub fn hemi_rgb(&self, v: DVec3) -> DVec3 {
+        self.in_index(v).map_or(DVec3::ZERO, |i| self.hemi_rgb[i])
+    }
+
+    fn colour_at(&self, o: usize, i: usize) -> DVec3 {
+        match &self.colour {
+            Some(c) => {
+                let f = c[o * self.m.incident.len() + i];
+                DVec3::new(f64::from(f[0]), f64::from(f[1]), f64::from(f[2]))
+            }
+            None => DVec3::ONE,
+        }
+    }
+
+    /// Colour (RGB over Y) of the element for view `v` and light `l`.
+    pub fn colour(&self, v: DVec3, l: DVec3) -> DVec3 {
+        match (self.in_index(v), self.out_index(l)) {
+            (Some(i), Some(o)) => self.colour_at(o, i),
+            _ => DVec3::ONE,
+        }
     }
 
     /// Projected solid angle of the incident patch holding view `v`.
@@ -266,8 +324,9 @@ impl Component {
         }
     }
 
-    /// Samples an outgoing direction for view `v`: (local direction, hemispherical total).
-    pub fn sample(&self, v: DVec3, u: f64, u0: f64, u1: f64) -> Option<(DVec3, f64)> {
+    /// Samples an outgoing direction for view `v`: (local direction, hemispherical total,
+    /// colour of the element drawn).
+    pub fn sample(&self, v: DVec3, u: f64, u0: f64, u1: f64) -> Option<(DVec3, f64, DVec3)> {
         let i = self.in_index(v)?;
         let cdf = &self.cdf[i];
         let tot = *cdf.last()?;
@@ -278,7 +337,7 @@ impl Component {
         let o = cdf.partition_point(|&c| c <= x).min(cdf.len() - 1);
         let d = self.m.outgoing.sample_projected(o, u0, u1)?;
         let z = if self.out_back { -d[2] } else { d[2] };
-        Some((DVec3::new(d[0], d[1], z), tot))
+        Some((DVec3::new(d[0], d[1], z), tot, self.colour_at(o, i)))
     }
 }
 
@@ -357,27 +416,37 @@ pub fn compile(p: &Primitive) -> Result<BsdfMat> {
             through,
         });
     }
-    let get = |d: Direction, in_back: bool, out_back: bool| match b.klems(d, &vis) {
-        None => (None, 0.0),
-        Some(m) => {
-            let (rest, lamb) = split(m);
-            (
-                rest.map(|r| Arc::new(Component::new(r, in_back, out_back))),
-                lamb,
-            )
+    // Radiance's load: colour encoded, the Lambertian part split off (rf rb tf tb order)
+    let comps = fenestra_bsdf::radiance::render_components(&b);
+    let get = |d: Direction, in_back: bool, out_back: bool| {
+        let k = match d {
+            Direction::ReflectionBack => 0,
+            Direction::ReflectionFront => 1,
+            Direction::TransmissionBack => 2,
+            Direction::TransmissionFront => 3,
+        };
+        match &comps[k] {
+            None => (None, DVec3::ZERO, 0.0),
+            Some(c) => (
+                c.remainder
+                    .clone()
+                    .map(|r| Arc::new(Component::new(r, c.rgb.clone(), in_back, out_back))),
+                DVec3::from(c.lambertian) * std::f64::consts::PI,
+                c.lambertian_y * std::f64::consts::PI,
+            ),
         }
     };
-    let (rf, l_rf) = get(Direction::ReflectionBack, false, false);
-    let (rb, l_rb) = get(Direction::ReflectionFront, true, true);
-    let (tf, mut l_tf) = get(Direction::TransmissionBack, false, true);
-    let (tb, mut l_tb) = get(Direction::TransmissionFront, true, false);
+    let (rf, c_rf, l_rf) = get(Direction::ReflectionBack, false, false);
+    let (rb, c_rb, l_rb) = get(Direction::ReflectionFront, true, true);
+    let (tf, mut c_tf, mut l_tf) = get(Direction::TransmissionBack, false, true);
+    let (tb, mut c_tb, mut l_tb) = get(Direction::TransmissionFront, true, false);
     // one transmission matrix: its Lambertian part serves both sides, as in Radiance
     let has = |d: Direction| b.klems(d, &vis).is_some();
     if !has(Direction::TransmissionBack) {
-        l_tf = l_tb;
+        (c_tf, l_tf) = (c_tb, l_tb);
     }
     if !has(Direction::TransmissionFront) {
-        l_tb = l_tf;
+        (c_tb, l_tb) = (c_tf, l_tf);
     }
     let any = [
         Direction::ReflectionBack,
@@ -401,10 +470,10 @@ pub fn compile(p: &Primitive) -> Result<BsdfMat> {
         rb,
         tf,
         tb,
-        rd_front: v3(0) + DVec3::splat(l_rf),
-        rd_back: v3(3) + DVec3::splat(l_rb),
-        td_front: v3(6) + DVec3::splat(l_tf),
-        td_back: v3(6) + DVec3::splat(l_tb),
+        rd_front: v3(0) + c_rf,
+        rd_back: v3(3) + c_rb,
+        td_front: v3(6) + c_tf,
+        td_back: v3(6) + c_tb,
         tree: None,
         thick,
         through,

@@ -188,17 +188,21 @@ impl Tracer {
         // views; a view whose value is no more than the Lambertian part counts as zero, one
         // landing in a cell under 0.12 of the first's size (a finer tree leaf) is left
         // out; then the Lambertian part is taken off again
-        let remainder = |c: &LobeData, ll: DVec3, diff_y: f64| {
+        // (a coloured file: each view's value carries its element's colour; the result is
+        // the luminance so found in the mean colour of the views counted)
+        let remainder = |c: &LobeData, ll: DVec3, diff_y: f64| -> DVec3 {
             let (f0, tomega) = c.eval_sized(v, ll);
             let radius = tomega.max(0.0).sqrt() * shrink;
             if radius <= 0.0 {
-                return f0;
+                return f0 * c.colour(v, ll);
             }
             let mut g = jit.borrow_mut();
             let (mut sum, mut count) = (0.0, 0usize);
+            let (mut sum_c, mut sum_f) = (DVec3::ZERO, 0.0);
             for _ in 0..nview {
                 let (u, w) = (g.next_f64(), g.next_f64());
-                let (f, size) = c.eval_sized(jitter(v, radius, u, w), ll);
+                let vj = jitter(v, radius, u, w);
+                let (f, size) = c.eval_sized(vj, ll);
                 if f <= FTINY {
                     count += 1;
                     continue;
@@ -207,12 +211,19 @@ impl Tracer {
                     continue;
                 }
                 sum += f + diff_y;
+                sum_c += f * c.colour(vj, ll);
+                sum_f += f;
                 count += 1;
             }
             if count == 0 {
-                return 0.0;
+                return DVec3::ZERO;
             }
-            (sum / count as f64 - diff_y).max(0.0)
+            let y = (sum / count as f64 - diff_y).max(0.0);
+            if sum_f > 0.0 {
+                sum_c * (y / sum_f)
+            } else {
+                DVec3::splat(y)
+            }
         };
         // with a thickness, reflected and transmitted light are gathered at two points
         let only = std::cell::Cell::new(None::<bool>);
@@ -238,7 +249,9 @@ impl Tracer {
             } else {
                 (trans, td, b.lamb[2 + usize::from(!front)])
             };
-            let f = DVec3::splat(comp.as_ref().map_or(0.0, |c| remainder(c, ll, own / PI)))
+            let f = comp
+                .as_ref()
+                .map_or(DVec3::ZERO, |c| remainder(c, ll, own / PI))
                 + diffuse / PI;
             f * (ldot.abs() * omega)
         };
@@ -281,12 +294,20 @@ impl Tracer {
             }
             let big = c.view_size(v).sqrt() * shrink;
             let (u, w) = (cx.rng.next_f64(), cx.rng.next_f64());
-            let total = (c.hemi(jitter(v, big, u, w)) - taken).max(0.0);
+            let vj = jitter(v, big, u, w);
+            let hemi = c.hemi(vj);
+            let total = (hemi - taken).max(0.0);
             if total <= st + FTINY {
-                if flag == REFLECTED {
-                    rdiff += DVec3::splat(total);
+                // folded into the diffuse part, in the lobe's own colour
+                let folded = if hemi > 0.0 {
+                    c.hemi_rgb(vj) * (total / hemi)
                 } else {
-                    tdiff += DVec3::splat(total);
+                    DVec3::ZERO
+                };
+                if flag == REFLECTED {
+                    rdiff += folded;
+                } else {
+                    tdiff += folded;
                 }
                 continue;
             }
@@ -305,13 +326,13 @@ impl Tracer {
                 };
                 let (ju, jw) = (cx.rng.next_f64(), cx.rng.next_f64());
                 let vs = jitter(v, small, ju, jw);
-                if let Some((d, h)) = c.sample(vs, xr, u0, u1) {
+                if let Some((d, h, colour)) = c.sample(vs, xr, u0, u1) {
                     // the through ray already carries the view's own direction
                     if thru && (vs.x + d.x).powi(2) + (vs.y + d.y).powi(2) <= small * small {
                         continue;
                     }
                     let dir = (x * d.x + y * d.y + z * d.z).normalize();
-                    let coef = DVec3::splat(h / nsamp as f64);
+                    let coef = colour * (h / nsamp as f64);
                     let from = if flag == TRANS && b.thick != 0.0 {
                         Surf { p: behind, ..*s }
                     } else {
