@@ -502,3 +502,50 @@ fn reference_bsdf_window_colour_distribution_and_proxy() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn native_illum_patterns_give_the_cal_engine_s_numbers() {
+    // A proxy's distribution over fenestra's own illum.cal is evaluated natively; the same
+    // file with one comment added goes through the .cal engine. Both renderings (flat
+    // colordata and brightdata illums, and a spherical one) must be the same bytes.
+    let dir = common::scratch("mkillum-native");
+    std::fs::write(
+        dir.join("scene.rad"),
+        format!("{SKY}void plastic grey 0 0 5 .5 .5 .5 0 0\ngrey polygon box 0 0 12 -1 -1 2 1 -1 2 1 1 2 -1 1 2\n"),
+    )
+    .unwrap();
+    let mut mk = ours(&dir);
+    mk.args(["-ab", "1", "-ad", "64", "scene.rad"]);
+    let out = common::run_stdin(
+        mk,
+        b"#@mkillum c=d d=12 s=4 m=a\nvoid polygon w 0 0 12 0 0 0 0 0.5 0 0.5 0.5 0 0.5 0 0\n\
+          #@mkillum c=n m=b\nvoid polygon w2 0 0 12 1 0 0 1 0.5 0 1.5 0.5 0 1.5 0 0\n\
+          #@mkillum m=c\nvoid sphere s 0 0 4 0 0 5 0.3\n",
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    std::fs::write(dir.join("illum.rad"), &out.stdout).unwrap();
+    std::fs::create_dir_all(dir.join("alt")).unwrap();
+    let mut cal = std::fs::read_to_string(common::fenestra_lib().join("illum.cal")).unwrap();
+    cal.push_str("{ a copy: not the shipped text }\n");
+    std::fs::write(dir.join("alt/illum.cal"), cal).unwrap();
+    let rays = b"0.2 0.2 -1 0 0 1\n0.3 0.1 -2 0.1 0.2 1\n1.2 0.2 -1 0 0.3 1\n0 0 3 0 0 1\n0.5 0.5 -0.5 0.2 0.2 1\n";
+    let render = |raypath: &str| {
+        let mut rt = common::fenestra("rtrace");
+        rt.args(["-h", "-ab", "0", "-I+", "scene.rad", "illum.rad"])
+            .current_dir(&dir)
+            .env("RAYPATH", raypath);
+        let r = common::run_stdin(rt, rays);
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        r.stdout
+    };
+    let lib = common::fenestra_lib().display().to_string();
+    let native = render(&format!(".:{lib}"));
+    let engine = render(&format!(".:alt:{lib}"));
+    assert_eq!(native, engine);
+    assert!(common::numbers(&native).iter().any(|&v| v > 0.0));
+    let _ = std::fs::remove_dir_all(&dir);
+}

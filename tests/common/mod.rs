@@ -83,6 +83,11 @@ pub fn fenestra(name: &str) -> Command {
     c
 }
 
+/// fenestra's library folder (`lib/`: its .cal files).
+pub fn fenestra_lib() -> PathBuf {
+    repo().join("lib")
+}
+
 /// A file or folder under `tests/fixtures/`.
 pub fn fixture(rel: &str) -> PathBuf {
     repo().join("tests/fixtures").join(rel)

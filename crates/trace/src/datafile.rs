@@ -142,6 +142,39 @@ impl DataGrid {
         Ok(DataGrid { axes, values })
     }
 
+    /// Whether two grids share their axes (one location serves both).
+    pub fn same_axes(&self, other: &DataGrid) -> bool {
+        self.axes == other.axes
+    }
+
+    /// Where 2-D coordinates fall: the lower indices and fractions per axis.
+    pub fn locate2(&self, x: [f64; 2]) -> ([usize; 2], [f64; 2]) {
+        let (l0, f0) = self.axes[0].locate(x[0]);
+        let (l1, f1) = self.axes[1].locate(x[1]);
+        ([l0, l1], [f0, f1])
+    }
+
+    /// Bilinear interpolation of a 2-D grid at a location from [`Self::locate2`] (the same
+    /// arithmetic, in the same order, as [`Self::value`]).
+    pub fn value_at2(&self, lo: [usize; 2], fr: [f64; 2]) -> f64 {
+        let (m0, m1) = (self.axes[0].len(), self.axes[1].len());
+        let mut sum = 0.0;
+        for corner in 0..4usize {
+            let (h0, h1) = (corner & 2 != 0, corner & 1 != 0);
+            if (h0 && m0 < 2) || (h1 && m1 < 2) {
+                continue;
+            }
+            let w0 = if h0 { fr[0] } else { 1.0 - fr[0] };
+            let w1 = if h1 { fr[1] } else { 1.0 - fr[1] };
+            let w = 1.0 * w0 * w1;
+            if w != 0.0 {
+                let idx = (lo[0] + usize::from(h0)) * m1 + lo[1] + usize::from(h1);
+                sum += w * self.values[idx];
+            }
+        }
+        sum
+    }
+
     /// Multilinear interpolation at `x` (one coordinate per dimension).
     pub fn value(&self, x: &[f64]) -> f64 {
         let n = self.axes.len();

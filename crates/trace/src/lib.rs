@@ -15,6 +15,7 @@ pub mod bsdf_mat;
 pub mod bvh;
 pub mod clip;
 pub mod datafile;
+pub mod illum_pattern;
 pub mod material;
 pub mod options;
 pub mod pattern;

@@ -251,6 +251,8 @@ pub enum Pattern {
     Cal(Arc<CalPattern>),
     /// `brightdata`/`colordata`: interpolated data files.
     Data(Arc<DataPattern>),
+    /// An mkillum distribution over fenestra's `illum.cal`, evaluated natively.
+    Illum(Arc<crate::illum_pattern::IllumPattern>),
 }
 
 /// A `brightdata` (one grid) or `colordata` (three grids) pattern: coordinate
@@ -312,6 +314,7 @@ impl Pattern {
             Pattern::Perez(p) => DVec3::splat(p.radiance(q.dir.to_array())),
             Pattern::Cal(c) => c.eval(q).unwrap_or(DVec3::ZERO),
             Pattern::Data(d) => d.eval(q).unwrap_or(DVec3::ZERO),
+            Pattern::Illum(p) => p.eval(q),
         }
     }
 }
@@ -390,6 +393,35 @@ fn compile_data(q: &fenestra_scene::Primitive, what: &str, user: &[CalSource]) -
         );
     }
     let (coords, xf) = coords.split_at(dims);
+    if xf.is_empty() && user.is_empty() {
+        let text = |name: &str| {
+            fenestra_cli::raypath::find(name).and_then(|p| std::fs::read_to_string(p).ok())
+        };
+        if let (Some(c), Some(r)) = (text(cal), text("rayinit.cal")) {
+            let nf = q.sargs[..nf].to_vec();
+            let coords = coords.to_vec();
+            if crate::illum_pattern::IllumPattern::recognise(&nf, &c, &r, &coords, &q.rargs, &grids)
+                .is_some()
+            {
+                let r = &q.rargs;
+                let frame = (coords[0] == "il_alth").then(|| {
+                    [
+                        DVec3::new(r[0], r[1], r[2]),
+                        DVec3::new(r[3], r[4], r[5]),
+                        DVec3::new(r[6], r[7], r[8]),
+                    ]
+                });
+                let shared = grids.iter().all(|g| g.same_axes(&grids[0]));
+                return Ok(Pattern::Illum(Arc::new(
+                    crate::illum_pattern::IllumPattern {
+                        grids,
+                        frame,
+                        shared,
+                    },
+                )));
+            }
+        }
+    }
     let frame = PatternFrame::parse(xf).map_err(|e| anyhow!("{what}: {e:#}"))?;
     let mut p = program(user, cal).map_err(|e| anyhow!("{what}: {e:#}"))?;
     let vars = p.bind_vars(&HOST_VARS);
