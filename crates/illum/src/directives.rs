@@ -49,6 +49,11 @@ pub struct Settings {
     pub nsamps: i64,
     /// `b=`: minimum average brightness.
     pub minbrt: f64,
+    /// `d=file.xml`: the window's BSDF (the distribution is its transmission of the
+    /// sampled outside; fenestra, as Radiance 4 had it).
+    pub bsdf: Option<String>,
+    /// `u=`: the BSDF's up vector (fenestra; default +Z, or +Y for a window facing up or down).
+    pub up: Option<glam::DVec3>,
 }
 
 impl Default for Settings {
@@ -64,6 +69,8 @@ impl Default for Settings {
             sampdens: 48,
             nsamps: 32,
             minbrt: 0.0,
+            bsdf: None,
+            up: None,
         }
     }
 }
@@ -79,12 +86,41 @@ pub struct LineEffect {
     pub processed: bool,
     /// Warnings to print (before the error count).
     pub warnings: Vec<String>,
+    /// `d=file`: a BSDF file was named (the caller loads it).
+    pub bsdf: Option<String>,
 }
 
 /// `true` for an integer word (optional sign, digits), as Radiance's `isintd`.
 fn is_int(w: &str) -> bool {
     let d = w.strip_prefix(['+', '-']).unwrap_or(w);
     !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit())
+}
+
+/// An up vector: `±X`, `±Y`, `±Z` or `x,y,z` (not zero), normalised.
+fn direction(s: &str) -> Option<glam::DVec3> {
+    let (neg, rest) = match s.as_bytes().first() {
+        Some(b'-') => (true, &s[1..]),
+        Some(b'+') => (false, &s[1..]),
+        _ => (false, s),
+    };
+    let sign = if neg { -1.0 } else { 1.0 };
+    let d = match rest {
+        "x" | "X" => glam::DVec3::X * sign,
+        "y" | "Y" => glam::DVec3::Y * sign,
+        "z" | "Z" => glam::DVec3::Z * sign,
+        _ => {
+            let v: Vec<f64> = s
+                .split(',')
+                .map(|w| w.trim().parse::<f64>().ok())
+                .collect::<Option<_>>()?;
+            if v.len() != 3 {
+                return None;
+            }
+            glam::DVec3::new(v[0], v[1], v[2])
+        }
+    };
+    let l = d.length();
+    (l > 0.0 && l.is_finite()).then(|| d / l)
 }
 
 /// `true` for a real number word, as Radiance's `isfltd`.
@@ -194,12 +230,21 @@ impl Settings {
                 None => true,
                 Some(v) if is_int(v) => {
                     self.sampdens = v.parse().unwrap_or(0);
+                    self.bsdf = None;
                     true
                 }
-                Some(_) => {
-                    fx.warnings.push("direct BSDF input unsupported".into());
-                    false
+                Some(v) => {
+                    self.bsdf = Some(v.to_string());
+                    fx.bsdf = Some(v.to_string());
+                    true
                 }
+            },
+            b'u' => match value("u=").and_then(direction) {
+                Some(d) => {
+                    self.up = Some(d);
+                    true
+                }
+                None => false,
             },
             b's' => match value("s=") {
                 Some(v) if is_int(v) => {
@@ -288,12 +333,11 @@ mod tests {
         assert_eq!((s.sampdens, s.nsamps, s.colour), (4, 8, Colour::Average));
         assert_eq!((s.datafile.as_str(), s.clobber), ("wdist", true));
         assert_eq!(s.flat_divisions(), (2, 6));
-        let fx = s.apply("m=win l+ q=3 b=x d=blinds.xml");
-        assert_eq!(fx.errors, 3);
-        assert_eq!(
-            fx.warnings,
-            vec!["direct BSDF input unsupported".to_string()]
-        );
+        let fx = s.apply("m=win l+ q=3 b=x d=blinds.xml u=0,0,2");
+        assert_eq!(fx.errors, 2);
+        assert_eq!(fx.bsdf.as_deref(), Some("blinds.xml"));
+        assert_eq!(s.up, Some(glam::DVec3::Z));
+        assert_eq!(s.apply("u=0,0,0").errors, 1);
         assert_eq!(s.matname, "win");
         assert_eq!(s.datafile, "wdist", "f= given: m= keeps the data-file name");
         assert!(s.light);

@@ -64,6 +64,8 @@ pub struct Filter<'a> {
     pub on_surface: Option<SurfaceHook<'a>>,
     /// Per-surface standard errors, collected when `Some`.
     pub errors: Option<Vec<SurfaceError>>,
+    /// BSDF files loaded by `d=` directives.
+    bsdfs: std::collections::HashMap<String, std::sync::Arc<crate::bsdf_mode::BsdfData>>,
 }
 
 fn warn(msg: impl std::fmt::Display) {
@@ -83,6 +85,7 @@ impl<'a> Filter<'a> {
             surfaces: 0,
             on_surface: None,
             errors: None,
+            bsdfs: std::collections::HashMap::new(),
         }
     }
 
@@ -156,7 +159,22 @@ impl<'a> Filter<'a> {
             }
             return self.emit(&l);
         }
-        let fx = self.settings.apply(&line[10..]);
+        let before = self.settings.clone();
+        let mut fx = self.settings.apply(&line[10..]);
+        if let Some(file) = fx.bsdf.take() {
+            if !self.bsdfs.contains_key(&file) {
+                match crate::bsdf_mode::load(&file) {
+                    Ok(d) => {
+                        self.bsdfs.insert(file.clone(), d);
+                    }
+                    Err(e) => {
+                        fx.warnings.push(format!("d={file}: {e:#}"));
+                        fx.errors += 1;
+                        self.settings.bsdf = before.bsdf.clone();
+                    }
+                }
+            }
+        }
         if fx.processed {
             warn(format!("({name}): already processed!"));
             return Ok(());
@@ -295,6 +313,10 @@ impl<'a> Filter<'a> {
             nsamps,
             light: il.light,
         };
+        let bsdf = il.bsdf.as_ref().and_then(|f| self.bsdfs.get(f)).cloned();
+        if let Some(data) = bsdf {
+            return self.convert_bsdf(p, name, out, &job, &data);
+        }
         let (dist, axes) = match p.ptype.as_str() {
             "polygon" => {
                 let face = Face::new(&p.rargs)
@@ -343,6 +365,68 @@ impl<'a> Filter<'a> {
                 return Ok(());
             }
         };
+        self.finish_surface(p, out, dist, axes)
+    }
+
+    /// BSDF-data mode (`d=file.xml`) for one surface.
+    fn convert_bsdf(
+        &mut self,
+        p: &Prim,
+        name: &str,
+        out: &mut String,
+        job: &Job,
+        data: &crate::bsdf_mode::BsdfData,
+    ) -> Result<()> {
+        if p.ptype != "polygon" {
+            self.pass_unchanged(
+                p,
+                out,
+                &format!(
+                    "{} \"{}\": BSDF input (d=file) needs a polygon window",
+                    p.ptype, p.name
+                ),
+                name,
+            );
+            return Ok(());
+        }
+        let face = Face::new(&p.rargs)
+            .map_err(|e| anyhow::anyhow!("({name}): polygon \"{}\": {e}", p.name))?;
+        let Some(face) = face else {
+            self.pass_unchanged(
+                p,
+                out,
+                &format!("cannot make illum for polygon \"{}\" (zero area)", p.name),
+                name,
+            );
+            return Ok(());
+        };
+        let up = self
+            .settings
+            .up
+            .unwrap_or_else(|| crate::bsdf_mode::default_up(face.norm));
+        let r = crate::bsdf_mode::face(job, &face, data, up)
+            .map_err(|e| anyhow::anyhow!("({name}): polygon \"{}\": {e}", p.name))?;
+        let Some((dist, axes)) = r else {
+            self.pass_unchanged(p, out, &format!("polygon \"{}\": bad aspect", p.name), name);
+            return Ok(());
+        };
+        // the distribution is always written, whatever d= was before
+        let keep = self.settings.sampdens;
+        self.settings.sampdens = self.settings.sampdens.max(1);
+        let r = self.finish_surface(p, out, dist, Some(axes));
+        self.settings.sampdens = keep;
+        r
+    }
+
+    /// Writes a sampled surface: its distribution and illum, or the surface unchanged when
+    /// too dim.
+    fn finish_surface(
+        &mut self,
+        p: &Prim,
+        out: &mut String,
+        dist: crate::sample::Distribution,
+        axes: Option<[glam::DVec3; 3]>,
+    ) -> Result<()> {
         let col = dist.average();
         if let Some(f) = self.on_surface.as_mut() {
             f(&p.name);

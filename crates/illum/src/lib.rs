@@ -4,6 +4,7 @@
 //! `brightdata`/`colordata` distribution over `illum.cal` holds the radiance seen through
 //! them; everything else passes through.
 
+pub mod bsdf_mode;
 pub mod directives;
 pub mod filter;
 pub mod geometry;

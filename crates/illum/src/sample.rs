@@ -37,7 +37,8 @@ pub struct Distribution {
 }
 
 impl Distribution {
-    fn new(nalt: usize, nazi: usize, nsamps: usize) -> Self {
+    /// An empty distribution.
+    pub fn new(nalt: usize, nazi: usize, nsamps: usize) -> Self {
         Distribution {
             nalt,
             nazi,
@@ -136,7 +137,8 @@ pub struct Job<'a> {
 }
 
 impl Job<'_> {
-    fn stream(&self, index: u64) -> (Rng, u64) {
+    /// The sampling stream and tracer ray index of ray `index` of this surface.
+    pub fn stream(&self, index: u64) -> (Rng, u64) {
         let id = (self.surface << 36) | index;
         (Rng::for_ray(self.seed ^ 0x6d6b_696c_6c75_6d00, id), id)
     }
@@ -194,7 +196,11 @@ pub fn face(job: &Job, f: &Face) -> Option<Distribution> {
             let dir = -(dn.x * f.u + dn.y * f.v + dn.z * f.norm);
             let (org, fails) = origin(&mut rng);
             match org {
-                Some(o) => (k, job.tracer.radiance(id, o - eps * dir, dir), fails),
+                Some(o) => (
+                    k,
+                    job.tracer.radiance_specular(id, o - eps * dir, dir),
+                    fails,
+                ),
                 None => (k, [0.0; 3], fails),
             }
         })
@@ -231,7 +237,7 @@ pub fn ring(job: &Job, r: &Ring) -> Distribution {
             let dn = job.local_dir(k, i, &mut rng);
             let dir = -(dn.x * r.u + dn.y * r.v + dn.z * r.axis);
             let org = r.point(rng.next_f64(), rng.next_f64()) + eps * r.axis;
-            (k, job.tracer.radiance(id, org, dir))
+            (k, job.tracer.radiance_specular(id, org, dir))
         })
         .collect();
     let mut dist = Distribution::new(job.nalt, job.nazi, s);
@@ -272,7 +278,7 @@ pub fn sphere(job: &Job, centre: DVec3, radius: f64) -> Distribution {
                 + r3 * radius * ph.cos() * u
                 + r3 * radius * ph.sin() * v
                 + radius * (1.01 - r3 * r3).sqrt() * out;
-            (k, job.tracer.radiance(id, org, -out))
+            (k, job.tracer.radiance_specular(id, org, -out))
         })
         .collect();
     let mut dist = Distribution::new(job.nalt, job.nazi, s);

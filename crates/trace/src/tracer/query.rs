@@ -45,6 +45,20 @@ impl Tracer {
         self.run(&Self::primary(org, d), cx)
     }
 
+    /// Radiance along a ray traced as Radiance's mkillum traces its sample rays (primary and
+    /// specular): light sources are not seen directly (they are sampled explicitly, mkillum's
+    /// `l+`), glows and everything they light are.
+    pub fn radiance_specular(&self, ray_index: u64, org: DVec3, dir: DVec3) -> [f64; 3] {
+        let cx = self.ctx(ray_index, &[], None, None);
+        let d = dir.normalize_or_zero();
+        if d == DVec3::ZERO {
+            return [0.0; 3];
+        }
+        let mut r = Self::primary(org, d);
+        r.flags = SPECULAR;
+        self.run(&r, cx)
+    }
+
     /// Irradiance at `point` itself on a surface facing `normal` (rtrace `-I` evaluates
     /// it at [`Self::rtrace_irradiance_point`] of the input point).
     pub fn irradiance(&self, ray_index: u64, point: DVec3, normal: DVec3) -> [f64; 3] {
