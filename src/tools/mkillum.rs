@@ -145,7 +145,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         if err_file.is_some() {
             filter.errors = Some(Vec::new());
         }
-        filter.on_surface = Some(Box::new(|_name: &str| progress.inc(1)));
+        filter.progress = Some(&progress);
         if inputs.is_empty() {
             let mut text = Vec::new();
             std::io::Read::read_to_end(&mut std::io::stdin(), &mut text)
@@ -159,7 +159,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             }
         }
         let errs = filter.errors.take();
-        filter.on_surface = None;
+        filter.progress = None;
         filter.finish()?;
         if let (Some(path), Some(errs)) = (&err_file, errs) {
             write_errors(path, &errs)?;

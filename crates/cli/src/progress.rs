@@ -32,6 +32,14 @@ impl Progress {
         Progress { bar }
     }
 
+    /// Starts over with `total` units labelled `label` (the next of several jobs).
+    pub fn restart(&self, total: u64, label: &str) {
+        self.bar.set_length(total);
+        self.bar.set_position(0);
+        self.bar.set_message(label.to_string());
+        self.bar.reset_eta();
+    }
+
     /// Whether anything is drawn.
     pub fn visible(&self) -> bool {
         !self.bar.is_hidden()

@@ -115,6 +115,7 @@ pub fn face(
         .map(|idx| {
             let (i, k) = (idx / s, idx % s);
             let (mut rng, id) = job.stream(idx as u64);
+            job.tick(1);
             let t = (k as f64 + rng.next_f64()) / s as f64;
             let (s0, s1) = spread2(t, &mut rng);
             let l = bsdf.incident.sample_projected(i, s0, s1)?;

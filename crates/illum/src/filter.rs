@@ -47,9 +47,6 @@ pub struct SurfaceError {
     pub rel: Vec<f64>,
 }
 
-/// A callback run after each converted surface (given its name).
-pub type SurfaceHook<'a> = Box<dyn FnMut(&str) + 'a>;
-
 /// The filter's state over a run.
 pub struct Filter<'a> {
     tracer: &'a Tracer,
@@ -60,10 +57,10 @@ pub struct Filter<'a> {
     done_header: bool,
     sink: Option<Sink>,
     surfaces: u64,
-    /// Called after each converted surface (progress).
-    pub on_surface: Option<SurfaceHook<'a>>,
     /// Per-surface standard errors, collected when `Some`.
     pub errors: Option<Vec<SurfaceError>>,
+    /// Progress per surface (rays), when shown.
+    pub progress: Option<&'a fenestra_cli::progress::Progress>,
     /// BSDF files loaded by `d=` directives.
     bsdfs: std::collections::HashMap<String, std::sync::Arc<crate::bsdf_mode::BsdfData>>,
 }
@@ -83,8 +80,8 @@ impl<'a> Filter<'a> {
             done_header: false,
             sink: Some(Sink::Stdout(std::io::stdout())),
             surfaces: 0,
-            on_surface: None,
             errors: None,
+            progress: None,
             bsdfs: std::collections::HashMap::new(),
         }
     }
@@ -312,7 +309,21 @@ impl<'a> Filter<'a> {
             nazi,
             nsamps,
             light: il.light,
+            progress: self.progress,
         };
+        if let Some(pr) = self.progress {
+            let bsdf_patches = il
+                .bsdf
+                .as_ref()
+                .and_then(|f| self.bsdfs.get(f))
+                .map(|d| d.incident.len());
+            let rays = if let Some(np) = bsdf_patches {
+                np * nsamps
+            } else {
+                nalt * nazi * nsamps
+            };
+            pr.restart(rays as u64, &format!("mkillum {}", p.name));
+        }
         let bsdf = il.bsdf.as_ref().and_then(|f| self.bsdfs.get(f)).cloned();
         if let Some(data) = bsdf {
             return self.convert_bsdf(p, name, out, &job, &data);
@@ -428,9 +439,6 @@ impl<'a> Filter<'a> {
         axes: Option<[glam::DVec3; 3]>,
     ) -> Result<()> {
         let col = dist.average();
-        if let Some(f) = self.on_surface.as_mut() {
-            f(&p.name);
-        }
         if crate::bright(col) <= self.settings.minbrt + 1e-6 {
             write::printobj(out, &p.modifier, p);
             return Ok(());

@@ -134,9 +134,18 @@ pub struct Job<'a> {
     pub nsamps: usize,
     /// Add light sources explicitly (`l+`).
     pub light: bool,
+    /// Progress (one unit per ray), if shown.
+    pub progress: Option<&'a fenestra_cli::progress::Progress>,
 }
 
 impl Job<'_> {
+    /// Counts `n` rays done.
+    pub fn tick(&self, n: u64) {
+        if let Some(p) = self.progress {
+            p.inc(n);
+        }
+    }
+
     /// The sampling stream and tracer ray index of ray `index` of this surface.
     pub fn stream(&self, index: u64) -> (Rng, u64) {
         let id = (self.surface << 36) | index;
@@ -192,6 +201,7 @@ pub fn face(job: &Job, f: &Face) -> Option<Distribution> {
         .map(|idx| {
             let (k, i) = (idx / s, idx % s);
             let (mut rng, id) = job.stream(idx as u64);
+            job.tick(1);
             let dn = job.local_dir(k, i, &mut rng);
             let dir = -(dn.x * f.u + dn.y * f.v + dn.z * f.norm);
             let (org, fails) = origin(&mut rng);
@@ -234,6 +244,7 @@ pub fn ring(job: &Job, r: &Ring) -> Distribution {
         .map(|idx| {
             let (k, i) = (idx / s, idx % s);
             let (mut rng, id) = job.stream(idx as u64);
+            job.tick(1);
             let dn = job.local_dir(k, i, &mut rng);
             let dir = -(dn.x * r.u + dn.y * r.v + dn.z * r.axis);
             let org = r.point(rng.next_f64(), rng.next_f64()) + eps * r.axis;
@@ -263,6 +274,7 @@ pub fn sphere(job: &Job, centre: DVec3, radius: f64) -> Distribution {
         .map(|idx| {
             let (k, i) = (idx / s, idx % s);
             let (mut rng, id) = job.stream(idx as u64);
+            job.tick(1);
             let t = (i as f64 + rng.next_f64()) / s as f64;
             let (s0, s1) = spread2(t, &mut rng);
             let (a, z) = (k / job.nazi, k % job.nazi);
