@@ -11,16 +11,7 @@
 # FENESTRA_BIN=dir to use already-built binaries)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
-top=$(cd "$here/../.." && pwd)
-if [ -z "${FENESTRA_BIN:-}" ]; then
-  echo "== building fenestra (cargo build --release)" >&2
-  cargo build --release --quiet --manifest-path "$top/Cargo.toml" --bins
-  target=$(cargo metadata --format-version 1 --no-deps --manifest-path "$top/Cargo.toml" |
-    sed -n 's/.*"target_directory":"\([^"]*\)".*/\1/p')
-  FENESTRA_BIN="$target/release"
-fi
-export PATH="$FENESTRA_BIN:$PATH"
-nproc=$(nproc 2>/dev/null || echo 2)
+. "$here/../lib.sh"
 out=${OUT:-$here/out}
 mkdir -p "$out"
 tp="$top/examples/three-phase"
