@@ -84,6 +84,26 @@ fn dimensions_of_a_matrix() {
         String::from_utf8_lossy(&out.stdout),
         "T.mtx: NROWS=145 NCOLS=145 NCOMP=3\n"
     );
+    // rcontrib's own matrices have no NROWS (it is written only with -y): the rows are
+    // counted from the data, ASCII (D.dmx) and float (V_rflux.vmx)
+    let out = run(
+        common::fenestra("getinfo"),
+        &base,
+        &["-d", "D.dmx", "V_rflux.vmx"],
+        None,
+    );
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout),
+        "D.dmx: NROWS=145 NCOLS=146 NCOMP=3\nV_rflux.vmx: NROWS=45 NCOLS=145 NCOMP=3\n"
+    );
+    // a truncated one is reported
+    let dir = common::scratch("getinfo-truncated");
+    let mut d = std::fs::read(base.join("D.dmx")).unwrap();
+    d.truncate(d.len() - 40);
+    std::fs::write(dir.join("cut.dmx"), d).unwrap();
+    let out = run(common::fenestra("getinfo"), &dir, &["-d", "cut.dmx"], None);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("not whole rows"));
 }
 
 /// Missing files and data without a header: a message naming the file, exit status 1.

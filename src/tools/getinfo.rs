@@ -161,5 +161,38 @@ fn dimensions(r: &mut impl BufRead, name: &str) -> Result<String> {
         let res = read_resolution(r, name)?;
         return Ok(res.to_string().trim_end().to_string());
     }
-    anyhow::bail!("{name}: unknown file type (neither a picture nor a matrix with NROWS and NCOLS)")
+    // rcontrib/rtcontrib write NROWS only with -y: count the rows the data hold (fenestra)
+    if let Ok(Some(nc)) = h.ncols() {
+        let ncomp = h.ncomp().ok().flatten().unwrap_or(3);
+        let per_row = nc * ncomp;
+        let size = match h.format().as_deref().map(str::trim) {
+            Some("float") => Some(4),
+            Some("double") => Some(8),
+            Some("ascii") | None => None,
+            Some(other) => anyhow::bail!("{name}: matrix format '{other}' without NROWS"),
+        };
+        let (values, rest) = match size {
+            Some(b) => {
+                let n = std::io::copy(r, &mut std::io::sink())
+                    .with_context(|| format!("{name}: read error"))? as usize;
+                (n / b, n % b)
+            }
+            None => {
+                let mut text = String::new();
+                r.read_to_string(&mut text)
+                    .with_context(|| format!("{name}: read error"))?;
+                (text.split_whitespace().count(), 0)
+            }
+        };
+        if per_row > 0 && rest == 0 && values % per_row == 0 {
+            return Ok(format!(
+                "NROWS={} NCOLS={nc} NCOMP={ncomp}",
+                values / per_row
+            ));
+        }
+        anyhow::bail!(
+            "{name}: {values} values are not whole rows of NCOLS={nc} x NCOMP={ncomp} (a truncated matrix?)"
+        );
+    }
+    anyhow::bail!("{name}: unknown file type (neither a picture nor a matrix with NCOLS)")
 }
