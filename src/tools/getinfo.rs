@@ -165,7 +165,7 @@ fn dimensions(r: &mut impl BufRead, name: &str) -> Result<String> {
     if let Ok(Some(nc)) = h.ncols() {
         let ncomp = h.ncomp().ok().flatten().unwrap_or(3);
         let per_row = nc * ncomp;
-        let size = match h.format().as_deref().map(str::trim) {
+        let size = match h.format().map(str::trim) {
             Some("float") => Some(4),
             Some("double") => Some(8),
             Some("ascii") | None => None,
