@@ -454,3 +454,26 @@ fn window_group_area_weighted() {
         .iter()
         .all(|x| (x[0] <= 1.0 || x[0] >= 2.0) && (0.0..=1.0).contains(&x[2])));
 }
+
+/// A whole room given as the window (a newcomer's pitfall): Radiance samples every wall
+/// piece perpendicular to -vd silently; fenestra samples them too but says why that is
+/// probably wrong. The window alone gets no such warning.
+#[test]
+fn a_whole_room_instead_of_the_window_is_warned_about() {
+    let room = common::fixture("rtrace_threephase_bsdf").join("room.rad");
+    let window = common::fixture("rcontrib").join("window_out.rad");
+    let run = |f: &std::path::Path| {
+        let mut c = common::fenestra("genklemsamp");
+        c.args(["-c", "1", "-vd", "0", "-1", "0"]).arg(f);
+        let out = c.output().unwrap();
+        assert!(out.status.success());
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let err = run(&room);
+    assert!(
+        err.contains("a whole room or wall instead of the window?"),
+        "{err}"
+    );
+    assert!(err.contains("face opposite ways"), "{err}");
+    assert!(!run(&window).contains("whole room"));
+}

@@ -174,7 +174,8 @@ fn dimensions(r: &mut impl BufRead, name: &str) -> Result<String> {
         let (values, rest) = match size {
             Some(b) => {
                 let n = std::io::copy(r, &mut std::io::sink())
-                    .with_context(|| format!("{name}: read error"))? as usize;
+                    .with_context(|| format!("{name}: read error"))?
+                    as usize;
                 (n / b, n % b)
             }
             None => {

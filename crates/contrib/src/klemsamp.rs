@@ -156,6 +156,10 @@ pub fn aperture_from_scene(scene: &Scene, vd: DVec3) -> Result<(Aperture, Vec<St
     let mut tris = Vec::new();
     let mut warnings = Vec::new();
     let mut used = 0;
+    // planes (offset along vd) and facings of the polygons kept, to catch a whole room
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    let (mut facing_vd, mut facing_back) = (0usize, 0usize);
+    let mut diag = 0.0f64;
     for p in &scene.prims {
         if !p.is_surface() {
             continue;
@@ -199,7 +203,31 @@ pub fn aperture_from_scene(scene: &Scene, vd: DVec3) -> Result<(Aperture, Vec<St
             continue;
         }
         used += 1;
+        if c > 0.0 {
+            facing_vd += 1;
+        } else {
+            facing_back += 1;
+        }
+        for q in &pts {
+            let o = q.dot(vd);
+            lo = lo.min(o);
+            hi = hi.max(o);
+            diag = diag.max((*q - pts[0]).length());
+        }
         tris.extend(triangulate(&pts));
+    }
+    // a window is polygons in one plane facing one way; a room gives walls in two planes
+    // facing each other (Radiance samples them all as the window, silently)
+    if used > 1 && (hi - lo > 1e-3 * diag.max(1e-3) || (facing_vd > 0 && facing_back > 0)) {
+        warnings.push(format!(
+            "the {used} polygons perpendicular to -vd lie {:.3} apart along it{} (a whole room or wall instead of the window?); all are sampled as the aperture: give only the window polygons (e.g. window_out.rad)",
+            hi - lo,
+            if facing_vd > 0 && facing_back > 0 {
+                " and face opposite ways"
+            } else {
+                ""
+            }
+        ));
     }
     if used == 0 {
         bail!(
