@@ -105,12 +105,32 @@ fn value(args: &[String], i: usize) -> Result<f64> {
     }
 }
 
+/// `gensky --help`: the synopsis and one line per option.
+const GENSKY_HELP: &str = "Usage: gensky month day hour [options]      (hour: local standard time, e.g. 14:30 or 14.5; +H or a zone suffix as Radiance)
+   Or: gensky -ang altitude azimuth [options]   (sun position in degrees, azimuth from south, west positive)
+   Or: gensky -defaults
+Writes a CIE sky (a sun 'source' plus a skybright.cal brightfunc) for oconv/rtrace/genskyvec.
+Options:
+  +s | -s      CIE clear sky with | without sun (default +s)
+  +i | -i      CIE intermediate sky with | without sun
+  -c           CIE overcast sky
+  -u           uniform sky
+  -g rfl       ground reflectance (default 0.2)
+  -b L | -B E  zenith radiance (W/sr/m2) | from horizontal diffuse irradiance (W/m2)
+  -r L | -R E  solar radiance | from horizontal direct irradiance (W/m2); -r 0 removes the sun
+  -t turb      turbidity (default 2.45)
+  -a lat       site latitude, degrees north
+  -o lon       site longitude, degrees west
+  -m mer       standard meridian, degrees west (default 120)
+  -y year      solar position for that year (Michalsky)
+See docs/tools/gensky.md.";
+
 /// Runs gensky.
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let mut inp = CieInputs::default();
     let mut site = Site::default();
     if args.len() == 2 && args[1] == "--help" {
-        println!("Usage: gensky month day hour [options]\n   Or: gensky -ang altitude azimuth [options]\n   Or: gensky -defaults\noptions: +s -s +i -i -c -u -g rfl -b zbr -B zirr -r sbr -R sirr -t turb -a lat -o lon -m mer -y year");
+        println!("{}", GENSKY_HELP);
         return Ok(ExitCode::SUCCESS);
     }
     if args.len() == 2 && args[1] == "-defaults" {

@@ -166,7 +166,17 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             "-h" => header = false,
             "-5" => opt.five_phase = true,
             "--help" => {
-                println!("Usage: genskyvec [-h][-m N][-c r g b][-d][-5] < sky.rad\nReinhart sky vector (ground first) of a sky description on standard input.");
+                println!(
+                    "Usage: genskyvec [-h][-m N][-c r g b][-d][-5] < sky.rad
+Reinhart sky vector (ground first) of a sky description (gensky, gendaylit) on standard input.
+Options:
+  -m N       Reinhart subdivision: 146, 578, 2306 rows for 1, 2, 4 (default 4: match D's -m/MF!)
+  -c r g b   sky colour (default 0.960 1.004 1.118)
+  -d         sun only (sky patches zero)
+  -5         five-phase: the sun into its single nearest patch
+  -h         no header
+See docs/tools/genskyvec.md."
+                );
                 return Ok(ExitCode::SUCCESS);
             }
             w => bail!("Unexpected command-line argument: {w}"),

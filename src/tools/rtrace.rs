@@ -9,6 +9,29 @@ use fenestra_trace::{DVec3, TraceOptions, Tracer};
 
 const USAGE: &str = "[-I|-i][-o{o,d,v,w,l,L,p,n,N}][-f{a,f,d}{a,f,d}][-h][-x N][-y N][-n N][-ab N][-ad N][-aa V][-ar N][-as N][-av r g b][-lw W][-lr N][-ds V][-dj V][-dc V][-dr N][-dt V][-st V][-ss V][-bv][-u][-v][-full][-seed N] scene.{rad,oct}…";
 
+/// `rtrace --help`: one line per option.
+const RTRACE_OPTIONS: &str = "Options:
+  -I | -i          irradiance at the input point (input: point normal) | at the first hit of each ray
+  -o{o,d,v,w,l,L,p,n,N}  values printed per ray (default -ov: radiance)
+  -f{a,f,d}{a,f,d} input / output format: ascii, float, double (default -faa)
+  -h               no header;  -w  warnings off;  -v  what the engine switched on and why
+  -n N             threads (same output for any N)
+  -x N -y N        flush every N records / picture size for -y
+  -ab N            ambient bounces (default 0)
+  -ad N            ambient divisions: hemisphere samples (default 1024)
+  -as N            ambient super-samples (default 512)
+  -aa V            ambient accuracy: accepted, no irradiance cache (pure Monte Carlo, as -aa 0)
+  -av r g b        ambient value beyond the last bounce (default 0 0 0)
+  -lw W            minimum ray weight (default 1e-4);  -lr N  maximum reflections (default -10)
+  -dt V -dc V      source thresholding and certainty (default .03, .75)
+  -dj V -ds V      source jitter (default 0) and subdivision (default .2);  -dr N  relays
+  -st V -ss V      specular threshold (default .15) and sampling (default 1)
+  -bv              back faces of emitters visible (default on)
+  -e expr -f file  .cal definitions for patterns
+  -seed N          random stream seed (fenestra);  -full  no effect selection
+  -defaults        print the values in effect;  -version
+See docs/tools/rtrace.md.";
+
 #[derive(Clone, Copy, PartialEq)]
 enum Fmt {
     Ascii,
@@ -38,7 +61,7 @@ use fenestra_cli::opts::bool_option as toggle;
 /// Runs rtrace.
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
     if args.iter().skip(1).any(|a| a == "--help") {
-        println!("{} {USAGE}\nTraces rays read from standard input (origin, direction) and prints values.", fenestra_cli::prog());
+        println!("{} {USAGE}\nTraces rays read from standard input (origin, direction) and prints values.\n{RTRACE_OPTIONS}", fenestra_cli::prog());
         return Ok(ExitCode::SUCCESS);
     }
     let mut o = TraceOptions::rtrace();
