@@ -26,9 +26,18 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     for it in &items {
         match it {
             Item::Opt(o) if o.key == "i" => {
-                let c = compiled::read_file(o.word())?;
-                inputs.extend(c.inputs);
-                parser.add_scene(c.scene)?;
+                let path = o.word();
+                let head = std::fs::read(path)
+                    .with_context(|| format!("cannot open octree '{path}'"))?;
+                if fenestra_scene::compiled::is_radiance_octree(&head) {
+                    // Radiance's octree: its objects (or files) through the scene reader
+                    parser.add_path(path)?;
+                    inputs.push(path.to_string());
+                } else {
+                    let c = compiled::read(&head).with_context(|| path.to_string())?;
+                    inputs.extend(c.inputs);
+                    parser.add_scene(c.scene)?;
+                }
             }
             Item::Opt(_) => {}
             Item::Pos(p) => {

@@ -7,6 +7,7 @@ pub mod compiled;
 mod mgf;
 mod model;
 mod rad;
+pub mod radoct;
 mod source;
 pub mod transform;
 pub mod types;

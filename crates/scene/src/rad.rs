@@ -46,7 +46,21 @@ impl Parser {
         }
         let bytes =
             std::fs::read(path).with_context(|| format!("cannot open scene file '{path}'"))?;
-        if crate::compiled::is_compiled(&bytes) || crate::compiled::is_radiance_octree(&bytes) {
+        if crate::compiled::is_radiance_octree(&bytes) {
+            let oct =
+                crate::radoct::read(&bytes).with_context(|| format!("{path}: Radiance octree"))?;
+            return match oct {
+                crate::radoct::RadianceOctree::Frozen(text) => self.add_str(&text, path),
+                crate::radoct::RadianceOctree::Files(files) => {
+                    for f in files {
+                        self.add_path(&f)
+                            .with_context(|| format!("{path}: a scene file the octree lists"))?;
+                    }
+                    Ok(())
+                }
+            };
+        }
+        if crate::compiled::is_compiled(&bytes) {
             let c = crate::compiled::read(&bytes).with_context(|| path.to_string())?;
             return self.add_scene(c.scene);
         }
