@@ -27,8 +27,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         match it {
             Item::Opt(o) if o.key == "i" => {
                 let path = o.word();
-                let head = std::fs::read(path)
-                    .with_context(|| format!("cannot open octree '{path}'"))?;
+                let head =
+                    std::fs::read(path).with_context(|| format!("cannot open octree '{path}'"))?;
                 if fenestra_scene::compiled::is_radiance_octree(&head) {
                     // Radiance's octree: its objects (or files) through the scene reader
                     parser.add_path(path)?;

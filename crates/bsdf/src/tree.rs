@@ -106,6 +106,38 @@ pub struct TreeError {
 }
 
 impl TensorTree {
+    /// The tree as `ScatteringData` text (values in their shortest exact form).
+    pub fn to_text(&self) -> String {
+        fn node(out: &mut String, n: &Node, depth: usize) {
+            for _ in 0..depth {
+                out.push_str("    ");
+            }
+            match n {
+                Node::Grid { values, .. } => {
+                    out.push('{');
+                    for v in values {
+                        out.push(' ');
+                        out.push_str(&format!("{v:e}"));
+                    }
+                    out.push_str(" }\n");
+                }
+                Node::Branch(ch) => {
+                    out.push_str("{\n");
+                    for c in ch {
+                        node(out, c, depth + 1);
+                    }
+                    for _ in 0..depth {
+                        out.push_str("    ");
+                    }
+                    out.push_str("}\n");
+                }
+            }
+        }
+        let mut out = String::new();
+        node(&mut out, &self.root, 0);
+        out
+    }
+
     /// Parses `ScatteringData` text of a tree of the given rank (3 or 4).
     pub fn parse(rank: usize, text: &str) -> Result<Self, TreeError> {
         Self::parse_checked(rank, text, &|_| Ok(()))

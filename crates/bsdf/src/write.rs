@@ -1,4 +1,5 @@
-//! Writing Klems BSDF XML in the layout Radiance's `wrapBSDF` produces.
+//! Writing BSDF XML (Klems matrices, or tensor trees) in the layout Radiance's `wrapBSDF`
+//! produces.
 
 use std::fmt::Write;
 
@@ -11,6 +12,9 @@ pub enum WriteError {
     /// A block holds tensor-tree data.
     #[error("block {0} holds tensor-tree data; only Klems matrices can be written")]
     TensorTree(usize),
+    /// A tensor-tree file with a block of another kind.
+    #[error("block {0} is not a tensor tree in a tensor-tree file")]
+    Mixed(usize),
 }
 
 fn escape(s: &str) -> String {
@@ -81,6 +85,41 @@ pub fn klems_xml(b: &Bsdf, comment: Option<&str>) -> Result<String, WriteError> 
             );
         }
         None => out.push_str("\t<Geometry></Geometry>\n"),
+    }
+    // tensor trees (genBSDF -t3/-t4): the structure, then each block's tree as its text
+    if let Some(s @ (DataStructure::TensorTree3 | DataStructure::TensorTree4)) = b.structure {
+        let name = if s == DataStructure::TensorTree3 {
+            "TensorTree3"
+        } else {
+            "TensorTree4"
+        };
+        let _ = writeln!(
+            out,
+            "\t<DataDefinition>\n\t\t<IncidentDataStructure>{name}</IncidentDataStructure>\n\t</DataDefinition>"
+        );
+        for (k, blk) in b.blocks.iter().enumerate() {
+            let BlockData::Tree(t) = &blk.data else {
+                return Err(WriteError::Mixed(k));
+            };
+            let _ = write!(
+                out,
+                "\t<WavelengthData>\n\t\t<LayerNumber>System</LayerNumber>\n\t\t<Wavelength unit=\"Integral\">{}</Wavelength>\n\t\t<SourceSpectrum>CIE Illuminant D65 1nm.ssp</SourceSpectrum>\n\t\t<DetectorSpectrum>{}</DetectorSpectrum>\n\t\t<WavelengthDataBlock>\n\t\t\t<WavelengthDataDirection>{}</WavelengthDataDirection>\n\t\t\t<AngleBasis>LBNL/Shirley-Chiu</AngleBasis>\n\t\t\t<ScatteringDataType>{}</ScatteringDataType>\n\t\t\t<ScatteringData>\n{}",
+                escape(blk.wavelength.xml_name()),
+                match blk.wavelength {
+                    Wavelength::CieX => "ASTM E308 1931 X.dsp",
+                    Wavelength::CieZ => "ASTM E308 1931 Z.dsp",
+                    _ => "ASTM E308 1931 Y.dsp",
+                },
+                blk.direction.xml_name(),
+                if blk.data_type.is_empty() { "BTDF" } else { &blk.data_type },
+                t.to_text()
+            );
+            out.push_str(
+                "\t\t\t</ScatteringData>\n\t\t</WavelengthDataBlock>\n\t</WavelengthData>\n",
+            );
+        }
+        out.push_str("</Layer>\n</Optical>\n</WindowElement>\n");
+        return Ok(out);
     }
     out.push_str(
         "\t<DataDefinition>\n\t\t<IncidentDataStructure>Columns</IncidentDataStructure>\n",

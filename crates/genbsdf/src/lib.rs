@@ -15,6 +15,8 @@
 
 mod summary;
 pub use summary::summary;
+pub mod reduce;
+pub mod tree4;
 
 use anyhow::{bail, Result};
 use fenestra_bsdf::{Block, BlockData, Bsdf, DataStructure, Direction, KlemsBasis, KlemsMatrix};
@@ -114,6 +116,65 @@ genbsdf_receiver_face source genbsdf_face\n0\n0\n4 0 0 1 180\n\
 void glow genbsdf_receiver_behind\n0\n0\n4 1 1 1 0\n\
 genbsdf_receiver_behind source genbsdf_behind\n0\n0\n4 0 0 -1 180\n";
 
+/// What both characterisations start from: the bounding box, genBSDF's warnings, and a
+/// tracer over the device with the two receivers (tracked).
+pub(crate) struct Setup {
+    pub(crate) dim: [f64; 6],
+    pub(crate) warnings: Vec<String>,
+    pub(crate) tracer: Tracer,
+    pub(crate) tracked: Vec<bool>,
+}
+
+/// Checks the device and builds its tracer with the receivers.
+pub(crate) fn setup(scene: &Scene, opts: &Options) -> Result<Setup> {
+    if !opts.forward && !opts.backward {
+        bail!("nothing to do: neither +forward nor +backward");
+    }
+    let dim = match opts.dim {
+        Some(d) => d,
+        None => bounding_box(scene)?,
+    };
+    let [x0, x1, y0, y1, z0, z1] = dim;
+    let (w, h) = (x1 - x0, y1 - y0);
+    if !(w > 0.0 && h > 0.0) {
+        bail!("the device's bounding box is empty ({w} x {h})");
+    }
+    if z0 >= 0.0 {
+        bail!("Device entirely inside room!");
+    }
+    let mut warnings = Vec::new();
+    if z1 > 1e-5 {
+        warnings.push("Device extends into room".to_string());
+    }
+    if z1 * z1 > 0.01 * w * h {
+        warnings.push("Device far behind Z==0 plane".to_string());
+    }
+    // the device with the two receivers
+    let mut parser = fenestra_scene::Parser::new();
+    parser.add_scene(scene.clone())?;
+    parser.add_str(RECEIVERS, "genBSDF receivers")?;
+    let full = parser.finish();
+    let tracer = Tracer::new(&full, &opts.trace)?;
+    // CIE X, Y, Z of an RGB contribution: Radiance's primaries with an equal-energy white
+    // (Y alone for `Visible`; X and Z too with `+C`)
+    let find = |name: &str| full.prims.iter().position(|p| p.name == name);
+    let (Some(face), Some(behind)) = (
+        find("genbsdf_receiver_face"),
+        find("genbsdf_receiver_behind"),
+    ) else {
+        bail!("internal: receivers missing");
+    };
+    let mut tracked = vec![false; full.prims.len()];
+    tracked[face] = true;
+    tracked[behind] = true;
+    Ok(Setup {
+        dim,
+        warnings,
+        tracer,
+        tracked,
+    })
+}
+
 /// What a run measured: the bounding box used and the BSDF.
 pub struct Characterised {
     /// `[x0, x1, y0, y1, z0, z1]`.
@@ -151,47 +212,15 @@ pub fn characterise_with(
     pool: &rayon::ThreadPool,
     done: &(dyn Fn() + Sync),
 ) -> Result<Characterised> {
-    if !opts.forward && !opts.backward {
-        bail!("nothing to do: neither +forward nor +backward");
-    }
-    let dim = match opts.dim {
-        Some(d) => d,
-        None => bounding_box(scene)?,
-    };
+    let Setup {
+        dim,
+        warnings,
+        tracer,
+        tracked,
+    } = setup(scene, opts)?;
     let [x0, x1, y0, y1, z0, z1] = dim;
     let (w, h) = (x1 - x0, y1 - y0);
-    if !(w > 0.0 && h > 0.0) {
-        bail!("the device's bounding box is empty ({w} x {h})");
-    }
-    if z0 >= 0.0 {
-        bail!("Device entirely inside room!");
-    }
-    let mut warnings = Vec::new();
-    if z1 > 1e-5 {
-        warnings.push("Device extends into room".to_string());
-    }
-    if z1 * z1 > 0.01 * w * h {
-        warnings.push("Device far behind Z==0 plane".to_string());
-    }
-    // the device with the two receivers
-    let mut parser = fenestra_scene::Parser::new();
-    parser.add_scene(scene.clone())?;
-    parser.add_str(RECEIVERS, "genBSDF receivers")?;
-    let full = parser.finish();
-    let tracer = Tracer::new(&full, &opts.trace)?;
-    // CIE X, Y, Z of an RGB contribution: Radiance's primaries with an equal-energy white
-    // (Y alone for `Visible`; X and Z too with `+C`)
     let [x_w, y_w, z_w] = fenestra_bsdf::radiance::rgb_to_xyz_matrix();
-    let find = |name: &str| full.prims.iter().position(|p| p.name == name);
-    let (Some(face), Some(behind)) = (
-        find("genbsdf_receiver_face"),
-        find("genbsdf_receiver_behind"),
-    ) else {
-        bail!("internal: receivers missing");
-    };
-    let mut tracked = vec![false; full.prims.len()];
-    tracked[face] = true;
-    tracked[behind] = true;
     let (nx, ny) = grid(opts.samples.max(1), w, h);
     let n = nx * ny;
     let basis = KlemsBasis::full();

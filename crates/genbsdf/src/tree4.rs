@@ -1,0 +1,212 @@
+//! genBSDF's anisotropic tensor tree (`-t4 L`): incident directions in the cells of a
+//! 2^L × 2^L Shirley–Chiu square over each hemisphere, what leaves binned into the same
+//! grid on either side, reduced as rttree_reduce does (culling percentile `-t`, reciprocity
+//! averaging of the reflection with `+a`). Frames as Radiance's genBSDF sets them through
+//! rfluxmtx (sender and receivers `h=∓scN u=-Y`): a cell (x, y) of the square maps through
+//! the concentric map to the disk point (dx, dy), and the direction of travel is
+//! (dx, dy, ±√(1 − dx² − dy²)), both for the incident rays and for the outgoing ones.
+
+use anyhow::Result;
+use fenestra_bsdf::tree::TensorTree;
+use fenestra_bsdf::{Block, BlockData, Bsdf, DataStructure, Direction, Wavelength};
+use fenestra_scene::Scene;
+use fenestra_trace::rng::{spread2, Rng};
+use fenestra_trace::DVec3;
+use rayon::prelude::*;
+
+use crate::reduce::{reciprocity, reduce, Grid};
+use crate::{grid, setup, Characterised, Options, Setup};
+
+/// Shirley and Chiu's concentric map of the unit square onto the unit disk.
+pub fn square_to_disk(sx: f64, sy: f64) -> (f64, f64) {
+    let a = 2.0 * sx - 1.0;
+    let b = 2.0 * sy - 1.0;
+    let q = std::f64::consts::FRAC_PI_4;
+    let (r, phi) = if a > -b {
+        if a > b {
+            (a, q * (b / a))
+        } else {
+            (b, q * (2.0 - a / b))
+        }
+    } else if a < b {
+        (-a, q * (4.0 + b / a))
+    } else if b != 0.0 {
+        (-b, q * (6.0 - a / b))
+    } else {
+        (0.0, 0.0)
+    };
+    let r = r * (1.0 - 1e-13);
+    (r * phi.cos(), r * phi.sin())
+}
+
+/// Its inverse: a point of the unit disk to the unit square.
+pub fn disk_to_square(x: f64, y: f64) -> (f64, f64) {
+    let q = std::f64::consts::FRAC_PI_4;
+    let r = (x * x + y * y).sqrt();
+    let mut phi = y.atan2(x);
+    if phi < -q {
+        phi += 8.0 * q;
+    }
+    let (a, b) = if phi < q {
+        (r, phi * r / q)
+    } else if phi < 3.0 * q {
+        ((2.0 * q - phi) * r / q, r)
+    } else if phi < 5.0 * q {
+        (-r, (4.0 * q - phi) * r / q)
+    } else {
+        ((phi - 6.0 * q) * r / q, -r)
+    };
+    ((a + 1.0) / 2.0, (b + 1.0) / 2.0)
+}
+
+/// The grid cell of a unit direction of travel (its x and y on the disk).
+fn cell_of(d: DVec3, n: usize) -> usize {
+    let (sx, sy) = disk_to_square(d.x, d.y);
+    let c = |s: f64| ((s * n as f64).floor().max(0.0) as usize).min(n - 1);
+    c(sx) * n + c(sy)
+}
+
+/// Characterises the device as anisotropic tensor trees of resolution 2^`log2`.
+pub fn characterise(
+    scene: &Scene,
+    opts: &Options,
+    log2: u32,
+    pctcull: f64,
+    recip: bool,
+    pool: &rayon::ThreadPool,
+    done: &(dyn Fn() + Sync),
+) -> Result<Characterised> {
+    let Setup {
+        dim,
+        warnings,
+        tracer,
+        tracked,
+    } = setup(scene, opts)?;
+    let [x0, x1, y0, y1, z0, z1] = dim;
+    let (w, h) = (x1 - x0, y1 - y0);
+    let y_w = fenestra_bsdf::radiance::rgb_to_xyz_matrix()[1];
+    let n = 1usize << log2;
+    let ncell = n * n;
+    let (nx, ny) = grid(opts.samples.max(1), w, h);
+    let ns = nx * ny;
+    let omega = std::f64::consts::PI / ncell as f64;
+    let mut blocks = Vec::new();
+    let mut sides = Vec::new();
+    if opts.backward {
+        sides.push((true, Direction::TransmissionBack, Direction::ReflectionBack));
+    }
+    if opts.forward {
+        sides.push((
+            false,
+            Direction::TransmissionFront,
+            Direction::ReflectionFront,
+        ));
+    }
+    for (side_k, &(from_room, tdir, rdir)) in sides.iter().enumerate() {
+        let z = if from_room { z1 + 1e-6 } else { z0 - 1e-6 };
+        // per incident cell: Y flux toward the far side (transmission) and back (reflection)
+        let rows: Vec<(Vec<f64>, Vec<f64>)> = pool.install(|| {
+            (0..ncell)
+                .into_par_iter()
+                .map(|cell| {
+                    let (ix, iy) = (cell / n, cell % n);
+                    let mut trans = vec![0.0; ncell];
+                    let mut refl = vec![0.0; ncell];
+                    for k in 0..ns {
+                        let index = ((side_k * ncell + cell) * ns + k) as u64;
+                        let mut rng = Rng::for_ray(0x7472_6565_3400, index);
+                        let (gx, gy) = (k % nx, k / nx);
+                        let px = x0 + w * (gx as f64 + rng.next_f64()) / nx as f64;
+                        let py = y0 + h * (gy as f64 + rng.next_f64()) / ny as f64;
+                        let t = (k as f64 + rng.next_f64()) / ns as f64;
+                        let (s1, s2) = spread2(t, &mut rng);
+                        let (dx, dy) = square_to_disk(
+                            (ix as f64 + s1) / n as f64,
+                            (iy as f64 + s2) / n as f64,
+                        );
+                        let dz = (1.0 - dx * dx - dy * dy).max(0.0).sqrt();
+                        let dir = DVec3::new(dx, dy, if from_room { -dz } else { dz });
+                        let org = DVec3::new(px, py, z);
+                        tracer.contributions(index, org, dir, &tracked, &mut |c| {
+                            let y: f64 = c.coef.iter().zip(y_w).map(|(a, w)| a * w).sum();
+                            let d = c.dir;
+                            let o = cell_of(d, n);
+                            // transmission: on past the device (toward the room for light
+                            // from outside, away from it for light from the room)
+                            if (d.z > 0.0) != from_room {
+                                trans[o] += y;
+                            } else {
+                                refl[o] += y;
+                            }
+                        });
+                    }
+                    done();
+                    (trans, refl)
+                })
+                .collect()
+        });
+        let scale = 1.0 / ns as f64 / omega;
+        for (dir, is_trans) in [(tdir, true), (rdir, false)] {
+            let mut data: Vec<f32> = Vec::with_capacity(ncell * ncell);
+            for r in &rows {
+                let v = if is_trans { &r.0 } else { &r.1 };
+                data.extend(v.iter().map(|x| (x * scale) as f32));
+            }
+            if recip && !is_trans {
+                reciprocity(4, log2, &mut data);
+            }
+            let text = reduce(
+                &Grid {
+                    rank: 4,
+                    log2,
+                    data: &data,
+                },
+                pctcull,
+            );
+            let tree = TensorTree::parse(4, &text)
+                .map_err(|e| anyhow::anyhow!("internal: reduced tree does not parse: {e:?}"))?;
+            blocks.push(Block {
+                wavelength: Wavelength::Visible,
+                direction: dir,
+                data_type: "BTDF".into(),
+                data: BlockData::Tree(tree),
+            });
+        }
+    }
+    let bsdf = Bsdf {
+        name: "Unnamed".into(),
+        width: Some(w),
+        height: Some(h),
+        thickness: Some(-z0),
+        structure: Some(DataStructure::TensorTree4),
+        blocks,
+        ..Default::default()
+    };
+    Ok(Characterised {
+        dim,
+        samples: ns,
+        warnings,
+        bsdf,
+        errors: None,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn concentric_map_round_trips() {
+        for i in 0..50 {
+            for j in 0..50 {
+                let (sx, sy) = ((i as f64 + 0.5) / 50.0, (j as f64 + 0.5) / 50.0);
+                let (x, y) = square_to_disk(sx, sy);
+                let (a, b) = disk_to_square(x, y);
+                assert!(
+                    (a - sx).abs() < 1e-9 && (b - sy).abs() < 1e-9,
+                    "{sx} {sy} -> {a} {b}"
+                );
+            }
+        }
+    }
+}
