@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use fenestra_genbsdf::{characterise_with, Options};
 
-const USAGE: &str = "[-q][-E errors.xml][{+|-}C][-t4 L [-t pct][{+|-}a]][-c Nsamp][-n Nproc][-r 'render opts'][{+|-}f[orward]][{+|-}b[ackward]][{+|-}mgf][{+|-}geom unit][-dim x0 x1 y0 y1 z0 z1] [input ..]";
+const USAGE: &str = "[-q][-E errors.xml][{+|-}C][-t3 L | -t4 L [-t pct][{+|-}a]][-c Nsamp][-n Nproc][-r 'render opts'][{+|-}f[orward]][{+|-}b[ackward]][{+|-}mgf][{+|-}geom unit][-dim x0 x1 y0 y1 z0 z1] [input ..]";
 
 /// Geometry units genBSDF accepts, with their length in metres.
 const UNITS: [(&str, f64); 5] = [
@@ -34,7 +34,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let mut error_file: Option<String> = None;
     let mut unit = 1.0;
     let mut render: Vec<String> = Vec::new();
-    let mut tree4: Option<u32> = None;
+    let mut tree: Option<(usize, u32)> = None;
     let mut pctcull = 90.0;
     let mut recip = true;
     let mut files: Vec<String> = Vec::new();
@@ -89,17 +89,14 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 i += 6;
             }
             "+C" | "-C" => o.colour = plus,
-            "-t4" => {
+            "-t4" | "-t3" => {
                 let l = number(i + 1)?;
                 if !(2.0..=6.0).contains(&l) || l.fract() != 0.0 {
-                    bail!("-t4 {l}: the tree resolution must be a whole number from 2 to 6 (2^L cells per dimension)");
+                    bail!("{a} {l}: the tree resolution must be a whole number from 2 to 6 (2^L cells per dimension)");
                 }
-                tree4 = Some(l as u32);
+                tree = Some((if a == "-t4" { 4 } else { 3 }, l as u32));
                 i += 1;
             }
-            "-t3" => bail!(
-                "-t3: isotropic tensor trees are not supported by fenestra's genBSDF yet (use -t4 L or the Klems default)"
-            ),
             "-t" => {
                 let p = number(i + 1)?;
                 if !(0.0..100.0).contains(&p) {
@@ -169,20 +166,27 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         bail!("no device geometry in the input");
     }
     let pool = fenestra_cli::threads::pool(nproc)?;
-    if tree4.is_some() && (o.colour || o.errors) {
-        bail!("+C and -E are not supported with tensor trees (-t4) yet");
+    if tree.is_some() && (o.colour || o.errors) {
+        bail!("+C and -E are not supported with tensor trees (-t3, -t4) yet");
     }
-    let ndir = match tree4 {
-        Some(l) => (1u64 << (2 * l)) * (u64::from(o.forward) + u64::from(o.backward)),
+    let sides = u64::from(o.forward) + u64::from(o.backward);
+    let ndir = match tree {
+        Some((4, l)) => (1u64 << (2 * l)) * sides,
+        Some((_, l)) => (1u64 << (l - 1)) * sides,
         None => fenestra_genbsdf::directions(&o),
     };
     let progress = fenestra_cli::progress::Progress::new(ndir, "genBSDF incident directions");
-    let got = match tree4 {
-        Some(l) => {
-            fenestra_genbsdf::tree4::characterise(&scene, &o, l, pctcull, recip, &pool, &|| {
-                progress.inc(1)
-            })?
-        }
+    let got = match tree {
+        Some((rank, l)) => fenestra_genbsdf::tree4::characterise(
+            &scene,
+            &o,
+            rank,
+            l,
+            pctcull,
+            recip,
+            &pool,
+            &|| progress.inc(1),
+        )?,
         None => characterise_with(&scene, &o, &pool, &|| progress.inc(1))?,
     };
     progress.finish();
@@ -220,7 +224,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let mut out = std::io::stdout().lock();
     out.write_all(xml.as_bytes())?;
     out.flush()?;
-    if !quiet && tree4.is_none() {
+    if !quiet && tree.is_none() {
         eprint!("{}", fenestra_genbsdf::summary(&bsdf));
     }
     Ok(ExitCode::SUCCESS)

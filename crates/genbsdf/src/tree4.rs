@@ -1,7 +1,8 @@
-//! genBSDF's anisotropic tensor tree (`-t4 L`): incident directions in the cells of a
-//! 2^L × 2^L Shirley–Chiu square over each hemisphere, what leaves binned into the same
-//! grid on either side, reduced as rttree_reduce does (culling percentile `-t`, reciprocity
-//! averaging of the reflection with `+a`). Frames as Radiance's genBSDF sets them through
+//! genBSDF's tensor trees: anisotropic (`-t4 L`: incident directions in the cells of a
+//! 2^L × 2^L Shirley–Chiu square over each hemisphere) and isotropic (`-t3 L`: incident
+//! directions in one plane, 2^(L−1) cells from grazing to normal), what leaves binned into
+//! the 2^L × 2^L grid on either side, reduced as rttree_reduce does (culling percentile `-t`,
+//! reciprocity averaging with `+a`: the reflection of a rank-4 tree, every rank-3 tree). Frames as Radiance's genBSDF sets them through
 //! rfluxmtx (sender and receivers `h=∓scN u=-Y`): a cell (x, y) of the square maps through
 //! the concentric map to the disk point (dx, dy), and the direction of travel is
 //! (dx, dy, ±√(1 − dx² − dy²)), both for the incident rays and for the outgoing ones.
@@ -66,10 +67,12 @@ fn cell_of(d: DVec3, n: usize) -> usize {
     c(sx) * n + c(sy)
 }
 
-/// Characterises the device as anisotropic tensor trees of resolution 2^`log2`.
+/// Characterises the device as tensor trees of rank `rank` (3 or 4) and resolution 2^`log2`.
+#[allow(clippy::too_many_arguments)] // genBSDF's tree settings, each a command-line option
 pub fn characterise(
     scene: &Scene,
     opts: &Options,
+    rank: usize,
     log2: u32,
     pctcull: f64,
     recip: bool,
@@ -87,6 +90,8 @@ pub fn characterise(
     let y_w = fenestra_bsdf::radiance::rgb_to_xyz_matrix()[1];
     let n = 1usize << log2;
     let ncell = n * n;
+    // incident cells: the square's (rank 4), or the plane's from grazing to normal (rank 3)
+    let nin = if rank == 4 { ncell } else { n / 2 };
     let (nx, ny) = grid(opts.samples.max(1), w, h);
     let ns = nx * ny;
     let omega = std::f64::consts::PI / ncell as f64;
@@ -106,24 +111,31 @@ pub fn characterise(
         let z = if from_room { z1 + 1e-6 } else { z0 - 1e-6 };
         // per incident cell: Y flux toward the far side (transmission) and back (reflection)
         let rows: Vec<(Vec<f64>, Vec<f64>)> = pool.install(|| {
-            (0..ncell)
+            (0..nin)
                 .into_par_iter()
                 .map(|cell| {
                     let (ix, iy) = (cell / n, cell % n);
                     let mut trans = vec![0.0; ncell];
                     let mut refl = vec![0.0; ncell];
                     for k in 0..ns {
-                        let index = ((side_k * ncell + cell) * ns + k) as u64;
+                        let index = ((side_k * nin + cell) * ns + k) as u64;
                         let mut rng = Rng::for_ray(0x7472_6565_3400, index);
                         let (gx, gy) = (k % nx, k / nx);
                         let px = x0 + w * (gx as f64 + rng.next_f64()) / nx as f64;
                         let py = y0 + h * (gy as f64 + rng.next_f64()) / ny as f64;
                         let t = (k as f64 + rng.next_f64()) / ns as f64;
                         let (s1, s2) = spread2(t, &mut rng);
-                        let (dx, dy) = square_to_disk(
-                            (ix as f64 + s1) / n as f64,
-                            (iy as f64 + s2) / n as f64,
-                        );
+                        let (dx, dy) = if rank == 4 {
+                            square_to_disk((ix as f64 + s1) / n as f64, (iy as f64 + s2) / n as f64)
+                        } else {
+                            // genBSDF's isotropic rays: sinθ uniform within the cell, the
+                            // azimuth at 0 give or take a sliver alternating with the cell
+                            let dx = 1.0 - 2.0 * (cell as f64 + s1) / n as f64;
+                            let side = if cell % 2 == 1 { -1.0 } else { 1.0 };
+                            let dy =
+                                (1.0 / n as f64).min((1.0 - dx * dx).max(0.0).sqrt()) * side * s2;
+                            (dx, dy)
+                        };
                         let dz = (1.0 - dx * dx - dy * dy).max(0.0).sqrt();
                         let dir = DVec3::new(dx, dy, if from_room { -dz } else { dz });
                         let org = DVec3::new(px, py, z);
@@ -147,23 +159,26 @@ pub fn characterise(
         });
         let scale = 1.0 / ns as f64 / omega;
         for (dir, is_trans) in [(tdir, true), (rdir, false)] {
-            let mut data: Vec<f32> = Vec::with_capacity(ncell * ncell);
+            let mut data: Vec<f32> = Vec::with_capacity(n.pow(rank as u32));
             for r in &rows {
                 let v = if is_trans { &r.0 } else { &r.1 };
                 data.extend(v.iter().map(|x| (x * scale) as f32));
             }
-            if recip && !is_trans {
-                reciprocity(4, log2, &mut data);
+            // a rank-3 grid's upper half of incident cells stays empty (as rttree_reduce
+            // fills it with zeros)
+            data.resize(n.pow(rank as u32), 0.0);
+            if recip && (rank == 3 || !is_trans) {
+                reciprocity(rank, log2, &mut data);
             }
             let text = reduce(
                 &Grid {
-                    rank: 4,
+                    rank,
                     log2,
                     data: &data,
                 },
                 pctcull,
             );
-            let tree = TensorTree::parse(4, &text)
+            let tree = TensorTree::parse(rank, &text)
                 .map_err(|e| anyhow::anyhow!("internal: reduced tree does not parse: {e:?}"))?;
             blocks.push(Block {
                 wavelength: Wavelength::Visible,
@@ -178,7 +193,11 @@ pub fn characterise(
         width: Some(w),
         height: Some(h),
         thickness: Some(-z0),
-        structure: Some(DataStructure::TensorTree4),
+        structure: Some(if rank == 4 {
+            DataStructure::TensorTree4
+        } else {
+            DataStructure::TensorTree3
+        }),
         blocks,
         ..Default::default()
     };
