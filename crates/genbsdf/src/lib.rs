@@ -175,6 +175,42 @@ pub(crate) fn setup(scene: &Scene, opts: &Options) -> Result<Setup> {
     })
 }
 
+/// The sides a run characterises: (light from the room?, transmission direction,
+/// reflection direction), backward first.
+pub(crate) fn sides(opts: &Options) -> Vec<(bool, Direction, Direction)> {
+    let mut sides = Vec::new();
+    if opts.backward {
+        sides.push((true, Direction::TransmissionBack, Direction::ReflectionBack));
+    }
+    if opts.forward {
+        sides.push((
+            false,
+            Direction::TransmissionFront,
+            Direction::ReflectionFront,
+        ));
+    }
+    sides
+}
+
+/// A jittered point of cell `k` of the `nx` × `ny` sample grid over the box's `w` × `h`
+/// face from (x0, y0).
+pub(crate) fn plane_point(
+    rng: &mut fenestra_trace::rng::Rng,
+    k: usize,
+    grid: (usize, usize),
+    x0: f64,
+    y0: f64,
+    w: f64,
+    h: f64,
+) -> (f64, f64) {
+    let (nx, ny) = grid;
+    let (ix, iy) = (k % nx, k / nx);
+    (
+        x0 + w * (ix as f64 + rng.next_f64()) / nx as f64,
+        y0 + h * (iy as f64 + rng.next_f64()) / ny as f64,
+    )
+}
+
 /// What a run measured: the bounding box used and the BSDF.
 pub struct Characterised {
     /// `[x0, x1, y0, y1, z0, z1]`.
@@ -230,19 +266,7 @@ pub fn characterise_with(
         .collect();
     let mut blocks = Vec::new();
     let mut error_blocks = Vec::new();
-    // (light from the room?, transmission direction, reflection direction)
-    let mut sides = Vec::new();
-    if opts.backward {
-        sides.push((true, Direction::TransmissionBack, Direction::ReflectionBack));
-    }
-    if opts.forward {
-        sides.push((
-            false,
-            Direction::TransmissionFront,
-            Direction::ReflectionFront,
-        ));
-    }
-    for (side_k, &(from_room, tdir, rdir)) in sides.iter().enumerate() {
+    for (side_k, &(from_room, tdir, rdir)) in sides(opts).iter().enumerate() {
         let z = if from_room { z1 + 1e-5 } else { z0 - 1e-5 };
         // per incident patch: flux fractions toward the far and near receivers, by patch
         // (indices 0..np far, np..2np near), and their per-sample sums of squares
@@ -259,9 +283,7 @@ pub fn characterise_with(
                         hits.clear();
                         let index = ((side_k * np + i) * n + k) as u64;
                         let mut rng = fenestra_trace::rng::Rng::for_ray(0x6e6e_b5df, index);
-                        let (ix, iy) = (k % nx, k / nx);
-                        let px = x0 + w * (ix as f64 + rng.next_f64()) / nx as f64;
-                        let py = y0 + h * (iy as f64 + rng.next_f64()) / ny as f64;
+                        let (px, py) = plane_point(&mut rng, k, (nx, ny), x0, y0, w, h);
                         let (u0, u1) = (rng.next_f64(), rng.next_f64());
                         let Some(b) = basis.sample_projected(i, u0, u1) else {
                             continue;

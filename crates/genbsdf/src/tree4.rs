@@ -8,57 +8,15 @@
 //! (dx, dy, ±√(1 − dx² − dy²)), both for the incident rays and for the outgoing ones.
 
 use anyhow::Result;
-use fenestra_bsdf::tree::TensorTree;
-use fenestra_bsdf::{Block, BlockData, Bsdf, DataStructure, Direction, Wavelength};
+use fenestra_bsdf::tree::{disk_to_square, square_to_disk, TensorTree};
+use fenestra_bsdf::{Block, BlockData, Bsdf, DataStructure, Wavelength};
 use fenestra_scene::Scene;
 use fenestra_trace::rng::{spread2, Rng};
 use fenestra_trace::DVec3;
 use rayon::prelude::*;
 
 use crate::reduce::{reciprocity, reduce, Grid};
-use crate::{grid, setup, Characterised, Options, Setup};
-
-/// Shirley and Chiu's concentric map of the unit square onto the unit disk.
-pub fn square_to_disk(sx: f64, sy: f64) -> (f64, f64) {
-    let a = 2.0 * sx - 1.0;
-    let b = 2.0 * sy - 1.0;
-    let q = std::f64::consts::FRAC_PI_4;
-    let (r, phi) = if a > -b {
-        if a > b {
-            (a, q * (b / a))
-        } else {
-            (b, q * (2.0 - a / b))
-        }
-    } else if a < b {
-        (-a, q * (4.0 + b / a))
-    } else if b != 0.0 {
-        (-b, q * (6.0 - a / b))
-    } else {
-        (0.0, 0.0)
-    };
-    let r = r * (1.0 - 1e-13);
-    (r * phi.cos(), r * phi.sin())
-}
-
-/// Its inverse: a point of the unit disk to the unit square.
-pub fn disk_to_square(x: f64, y: f64) -> (f64, f64) {
-    let q = std::f64::consts::FRAC_PI_4;
-    let r = (x * x + y * y).sqrt();
-    let mut phi = y.atan2(x);
-    if phi < -q {
-        phi += 8.0 * q;
-    }
-    let (a, b) = if phi < q {
-        (r, phi * r / q)
-    } else if phi < 3.0 * q {
-        ((2.0 * q - phi) * r / q, r)
-    } else if phi < 5.0 * q {
-        (-r, (4.0 * q - phi) * r / q)
-    } else {
-        ((phi - 6.0 * q) * r / q, -r)
-    };
-    ((a + 1.0) / 2.0, (b + 1.0) / 2.0)
-}
+use crate::{grid, plane_point, setup, sides, Characterised, Options, Setup};
 
 /// The grid cell of a unit direction of travel (its x and y on the disk).
 fn cell_of(d: DVec3, n: usize) -> usize {
@@ -96,18 +54,7 @@ pub fn characterise(
     let ns = nx * ny;
     let omega = std::f64::consts::PI / ncell as f64;
     let mut blocks = Vec::new();
-    let mut sides = Vec::new();
-    if opts.backward {
-        sides.push((true, Direction::TransmissionBack, Direction::ReflectionBack));
-    }
-    if opts.forward {
-        sides.push((
-            false,
-            Direction::TransmissionFront,
-            Direction::ReflectionFront,
-        ));
-    }
-    for (side_k, &(from_room, tdir, rdir)) in sides.iter().enumerate() {
+    for (side_k, &(from_room, tdir, rdir)) in sides(opts).iter().enumerate() {
         let z = if from_room { z1 + 1e-6 } else { z0 - 1e-6 };
         // per incident cell: Y flux toward the far side (transmission) and back (reflection)
         let rows: Vec<(Vec<f64>, Vec<f64>)> = pool.install(|| {
@@ -120,9 +67,7 @@ pub fn characterise(
                     for k in 0..ns {
                         let index = ((side_k * nin + cell) * ns + k) as u64;
                         let mut rng = Rng::for_ray(0x7472_6565_3400, index);
-                        let (gx, gy) = (k % nx, k / nx);
-                        let px = x0 + w * (gx as f64 + rng.next_f64()) / nx as f64;
-                        let py = y0 + h * (gy as f64 + rng.next_f64()) / ny as f64;
+                        let (px, py) = plane_point(&mut rng, k, (nx, ny), x0, y0, w, h);
                         let t = (k as f64 + rng.next_f64()) / ns as f64;
                         let (s1, s2) = spread2(t, &mut rng);
                         let (dx, dy) = if rank == 4 {
@@ -216,6 +161,7 @@ mod tests {
 
     #[test]
     fn concentric_map_round_trips() {
+        // the bsdf crate's pair (Radiance's scaling), which the tree reader uses too
         for i in 0..50 {
             for j in 0..50 {
                 let (sx, sy) = ((i as f64 + 0.5) / 50.0, (j as f64 + 0.5) / 50.0);

@@ -288,6 +288,22 @@ impl<'a> Filter<'a> {
         Ok(pos)
     }
 
+    /// The polygon's face; a zero-area one is passed unchanged (with the warning) and gives
+    /// `None`; bad arguments are an error.
+    fn face_of(&self, p: &Prim, name: &str, out: &mut String) -> Result<Option<Face>> {
+        let face = Face::new(&p.rargs)
+            .map_err(|e| anyhow::anyhow!("({name}): polygon \"{}\": {e}", p.name))?;
+        if face.is_none() {
+            self.pass_unchanged(
+                p,
+                out,
+                &format!("cannot make illum for polygon \"{}\" (zero area)", p.name),
+                name,
+            );
+        }
+        Ok(face)
+    }
+
     fn pass_unchanged(&self, p: &Prim, out: &mut String, why: &str, name: &str) {
         warn(format!("({name}): {why}"));
         write::printobj(out, &p.modifier, p);
@@ -330,15 +346,7 @@ impl<'a> Filter<'a> {
         }
         let (dist, axes) = match p.ptype.as_str() {
             "polygon" => {
-                let face = Face::new(&p.rargs)
-                    .map_err(|e| anyhow::anyhow!("({name}): polygon \"{}\": {e}", p.name))?;
-                let Some(face) = face else {
-                    self.pass_unchanged(
-                        p,
-                        out,
-                        &format!("cannot make illum for polygon \"{}\" (zero area)", p.name),
-                        name,
-                    );
+                let Some(face) = self.face_of(p, name, out)? else {
                     return Ok(());
                 };
                 match sample::face(&job, &face) {
@@ -400,15 +408,7 @@ impl<'a> Filter<'a> {
             );
             return Ok(());
         }
-        let face = Face::new(&p.rargs)
-            .map_err(|e| anyhow::anyhow!("({name}): polygon \"{}\": {e}", p.name))?;
-        let Some(face) = face else {
-            self.pass_unchanged(
-                p,
-                out,
-                &format!("cannot make illum for polygon \"{}\" (zero area)", p.name),
-                name,
-            );
+        let Some(face) = self.face_of(p, name, out)? else {
             return Ok(());
         };
         let up = self

@@ -4,6 +4,7 @@
 //! so the rays are the same for any thread count and from run to run.
 
 use anyhow::{bail, Result};
+use fenestra_bsdf::tree::square_to_disk;
 use fenestra_trace::rng::{spread2, Rng};
 use glam::DVec3;
 
@@ -44,29 +45,6 @@ fn reinhart_row_len(mf: usize, row: usize) -> usize {
     } else {
         mf * TREGENZA[row / mf]
     }
-}
-
-/// Shirley and Chiu's concentric map of the unit square onto the unit disk.
-pub fn square_to_disk(sx: f64, sy: f64) -> (f64, f64) {
-    let a = 2.0 * sx - 1.0;
-    let b = 2.0 * sy - 1.0;
-    let q = std::f64::consts::FRAC_PI_4;
-    let (r, phi) = if a > -b {
-        if a > b {
-            (a, q * (b / a))
-        } else {
-            (b, q * (2.0 - a / b))
-        }
-    } else if a < b {
-        (-a, q * (4.0 + b / a))
-    } else if b != 0.0 {
-        (-b, q * (6.0 - a / b))
-    } else {
-        (0.0, 0.0)
-    };
-    // stay strictly inside the disk so the normal component is never exactly zero
-    let r = r * (1.0 - 1e-13);
-    (r * phi.cos(), r * phi.sin())
 }
 
 /// A multiplier that permutes 0..n when applied modulo n (coprime with n).
