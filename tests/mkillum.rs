@@ -182,6 +182,21 @@ fn lux(text: &[u8]) -> Vec<f64> {
         .collect()
 }
 
+/// The reference room's scene files (paths) with the given window.
+fn room_with(window: &str) -> Vec<String> {
+    [
+        "materials.rad",
+        "room.rad",
+        "exterior.rad",
+        window,
+        "sky.rad",
+        "skyfunc_glow.rad",
+    ]
+    .iter()
+    .map(|f| fx(f))
+    .collect()
+}
+
 fn mean(v: &[f64]) -> f64 {
     v.iter().sum::<f64>() / v.len() as f64
 }
@@ -201,17 +216,7 @@ fn reference_glass_window_distribution_and_proxy() {
     //   proxy rendering: mean within 2% (measured +0.4%), each sensor within 8% (Radiance's
     //   own proxy vs no-proxy: mean |difference| 4.4%, max 8.3%; measured: 3.4%).
     let dir = common::scratch("mkillum-glass");
-    let scene: Vec<String> = [
-        "materials.rad",
-        "room.rad",
-        "exterior.rad",
-        "window_glass.rad",
-        "sky.rad",
-        "skyfunc_glow.rad",
-    ]
-    .iter()
-    .map(|f| fx(f))
-    .collect();
+    let scene = room_with("window_glass.rad");
     let mut oconv = common::fenestra("oconv");
     oconv.args(&scene);
     std::fs::write(dir.join("scene.oct"), common::run_ok(&mut oconv)).unwrap();
@@ -454,17 +459,7 @@ fn reference_bsdf_window_colour_distribution_and_proxy() {
     //   3% (measured -0.2%), each sensor within 15% (measured 5.9%; Radiance's own proxy vs
     //   no-proxy differ by 17.5% on average, 138% at worst).
     let dir = common::scratch("mkillum-bsdf");
-    let scene: Vec<String> = [
-        "materials.rad",
-        "room.rad",
-        "exterior.rad",
-        "window_bsdf.rad",
-        "sky.rad",
-        "skyfunc_glow.rad",
-    ]
-    .iter()
-    .map(|f| fx(f))
-    .collect();
+    let scene = room_with("window_bsdf.rad");
     let raypath = format!(".:{}", common::fixture("threephase").display());
     let pts = std::fs::read(fx("sensors.pts")).unwrap();
     let render = |oct: &str| -> Vec<u8> {
