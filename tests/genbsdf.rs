@@ -753,3 +753,68 @@ fn tensor_tree_t3_agrees_with_radiance_s_file() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn tensor_tree_colour_blocks_hold_the_slats_chromaticity() {
+    // -t4 3 +C on the reference blind: after each Visible tree come CIE-u and CIE-v trees
+    // (genBSDF's u′ = 4X/(X + 15Y + 3Z), v′ = 9Y/(…), 4/19 and 9/19 where nothing arrives).
+    // The slats are MGF "WarmWhite" (cxy .36 .37: u′ 0.2143, v′ 0.4955) and "MidGrey"
+    // (equal-energy grey: 4/19, 9/19): the median of every colour tree's values must lie
+    // between grey and warm white (measured: reflection u′ 0.2137, v′ 0.4906;
+    // transmission 0.2145, 0.4963, the light that passes after warm bounces being a
+    // little warmer than the file's mean); the oracle's checkBSDF reads it as coloured.
+    let dir = common::scratch("genbsdf-t4-colour");
+    let mut c = common::fenestra("genBSDF");
+    c.args(["-n", "2", "-q", "-t4", "3", "-c", "100", "+C", "+mgf"])
+        .arg(common::fixture("genbsdf/blinds_curved20.mgf"));
+    let xml = String::from_utf8(common::run_ok(&mut c)).unwrap();
+    let path = dir.join("t4c.xml");
+    std::fs::write(&path, &xml).unwrap();
+    let b = read_file(&path).unwrap();
+    let kinds: Vec<String> = b
+        .blocks
+        .iter()
+        .map(|k| format!("{} {}", k.wavelength.xml_name(), k.direction.xml_name()))
+        .collect();
+    assert_eq!(
+        kinds,
+        [
+            "Visible Transmission Back",
+            "CIE-u Transmission Back",
+            "CIE-v Transmission Back",
+            "Visible Reflection Back",
+            "CIE-u Reflection Back",
+            "CIE-v Reflection Back"
+        ]
+    );
+    // medians of the u′ and v′ trees' written values
+    let mut medians = Vec::new();
+    for part in xml.split("<Wavelength unit=\"Integral\">").skip(1) {
+        let kind = &part[..5];
+        if kind != "CIE-u" && kind != "CIE-v" {
+            continue;
+        }
+        let data = &part
+            [part.find("<ScatteringData>").unwrap() + 16..part.find("</ScatteringData>").unwrap()];
+        let mut v: Vec<f64> = data
+            .split(|c: char| c.is_whitespace() || c == '{' || c == '}')
+            .filter_map(|w| w.parse().ok())
+            .collect();
+        v.sort_by(f64::total_cmp);
+        medians.push((kind.to_string(), v[v.len() / 2]));
+    }
+    assert_eq!(medians.len(), 4);
+    for (kind, m) in &medians {
+        let (grey, warm) = if kind == "CIE-u" {
+            (4.0 / 19.0, 0.2143)
+        } else {
+            (9.0 / 19.0, 0.4955)
+        };
+        assert!(*m > grey - 1e-3 && *m < warm + 0.003, "{kind} median {m}");
+    }
+    if let Some(o) = common::oracle() {
+        let out = common::run_ok(o.command("checkBSDF").arg(&path));
+        assert!(String::from_utf8_lossy(&out).contains("Color: 1"));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

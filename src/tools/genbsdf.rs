@@ -166,8 +166,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         bail!("no device geometry in the input");
     }
     let pool = fenestra_cli::threads::pool(nproc)?;
-    if tree.is_some() && (o.colour || o.errors) {
-        bail!("+C and -E are not supported with tensor trees (-t3, -t4) yet");
+    if tree.is_some() && o.errors {
+        bail!("-E is not supported with tensor trees (-t3, -t4) yet");
     }
     let sides = u64::from(o.forward) + u64::from(o.backward);
     let ndir = match tree {

@@ -103,12 +103,14 @@ pub fn klems_xml(b: &Bsdf, comment: Option<&str>) -> Result<String, WriteError> 
             };
             let _ = write!(
                 out,
-                "\t<WavelengthData>\n\t\t<LayerNumber>System</LayerNumber>\n\t\t<Wavelength unit=\"Integral\">{}</Wavelength>\n\t\t<SourceSpectrum>CIE Illuminant D65 1nm.ssp</SourceSpectrum>\n\t\t<DetectorSpectrum>{}</DetectorSpectrum>\n\t\t<WavelengthDataBlock>\n\t\t\t<WavelengthDataDirection>{}</WavelengthDataDirection>\n\t\t\t<AngleBasis>LBNL/Shirley-Chiu</AngleBasis>\n\t\t\t<ScatteringDataType>{}</ScatteringDataType>\n\t\t\t<ScatteringData>\n{}",
+                "\t<WavelengthData>\n\t\t<LayerNumber>System</LayerNumber>\n\t\t<Wavelength unit=\"Integral\">{}</Wavelength>\n\t\t<SourceSpectrum>CIE Illuminant D65 1nm.ssp</SourceSpectrum>\n{}\t\t<WavelengthDataBlock>\n\t\t\t<WavelengthDataDirection>{}</WavelengthDataDirection>\n\t\t\t<AngleBasis>LBNL/Shirley-Chiu</AngleBasis>\n\t\t\t<ScatteringDataType>{}</ScatteringDataType>\n\t\t\t<ScatteringData>\n{}",
                 escape(blk.wavelength.xml_name()),
+                // wrapBSDF writes no detector for the u′ and v′ trees
                 match blk.wavelength {
-                    Wavelength::CieX => "ASTM E308 1931 X.dsp",
-                    Wavelength::CieZ => "ASTM E308 1931 Z.dsp",
-                    _ => "ASTM E308 1931 Y.dsp",
+                    Wavelength::CieX => "\t\t<DetectorSpectrum>ASTM E308 1931 X.dsp</DetectorSpectrum>\n",
+                    Wavelength::CieZ => "\t\t<DetectorSpectrum>ASTM E308 1931 Z.dsp</DetectorSpectrum>\n",
+                    Wavelength::CieU | Wavelength::CieV => "",
+                    _ => "\t\t<DetectorSpectrum>ASTM E308 1931 Y.dsp</DetectorSpectrum>\n",
                 },
                 blk.direction.xml_name(),
                 if blk.data_type.is_empty() { "BTDF" } else { &blk.data_type },

@@ -25,6 +25,15 @@ fn cell_of(d: DVec3, n: usize) -> usize {
     c(sx) * n + c(sy)
 }
 
+/// One value per (incident row, outgoing cell), single precision, in grid order.
+fn cell_values(rows: &[Vec<f64>], ncell: usize, f: impl Fn(&[f64], usize) -> f64) -> Vec<f32> {
+    let mut out = Vec::with_capacity(rows.len() * ncell);
+    for r in rows {
+        out.extend((0..ncell).map(|o| f(r, o) as f32));
+    }
+    out
+}
+
 /// Characterises the device as tensor trees of rank `rank` (3 or 4) and resolution 2^`log2`.
 #[allow(clippy::too_many_arguments)] // genBSDF's tree settings, each a command-line option
 pub fn characterise(
@@ -45,7 +54,9 @@ pub fn characterise(
     } = setup(scene, opts)?;
     let [x0, x1, y0, y1, z0, z1] = dim;
     let (w, h) = (x1 - x0, y1 - y0);
-    let y_w = fenestra_bsdf::radiance::rgb_to_xyz_matrix()[1];
+    let [x_w, y_w, z_w] = fenestra_bsdf::radiance::rgb_to_xyz_matrix();
+    // channels gathered per outgoing cell: Y, and with +C also X and Z
+    let nch = if opts.colour { 3 } else { 1 };
     let n = 1usize << log2;
     let ncell = n * n;
     // incident cells: the square's (rank 4), or the plane's from grazing to normal (rank 3)
@@ -56,14 +67,15 @@ pub fn characterise(
     let mut blocks = Vec::new();
     for (side_k, &(from_room, tdir, rdir)) in sides(opts).iter().enumerate() {
         let z = if from_room { z1 + 1e-6 } else { z0 - 1e-6 };
-        // per incident cell: Y flux toward the far side (transmission) and back (reflection)
+        // per incident cell: Y (then X, Z) flux toward the far side (transmission) and back
+        // (reflection), channel-major
         let rows: Vec<(Vec<f64>, Vec<f64>)> = pool.install(|| {
             (0..nin)
                 .into_par_iter()
                 .map(|cell| {
                     let (ix, iy) = (cell / n, cell % n);
-                    let mut trans = vec![0.0; ncell];
-                    let mut refl = vec![0.0; ncell];
+                    let mut trans = vec![0.0; nch * ncell];
+                    let mut refl = vec![0.0; nch * ncell];
                     for k in 0..ns {
                         let index = ((side_k * nin + cell) * ns + k) as u64;
                         let mut rng = Rng::for_ray(0x7472_6565_3400, index);
@@ -85,15 +97,22 @@ pub fn characterise(
                         let dir = DVec3::new(dx, dy, if from_room { -dz } else { dz });
                         let org = DVec3::new(px, py, z);
                         tracer.contributions(index, org, dir, &tracked, &mut |c| {
-                            let y: f64 = c.coef.iter().zip(y_w).map(|(a, w)| a * w).sum();
+                            let dot = |w: [f64; 3]| -> f64 {
+                                c.coef.iter().zip(w).map(|(a, w)| a * w).sum()
+                            };
                             let d = c.dir;
                             let o = cell_of(d, n);
                             // transmission: on past the device (toward the room for light
                             // from outside, away from it for light from the room)
-                            if (d.z > 0.0) != from_room {
-                                trans[o] += y;
+                            let to = if (d.z > 0.0) != from_room {
+                                &mut trans
                             } else {
-                                refl[o] += y;
+                                &mut refl
+                            };
+                            to[o] += dot(y_w);
+                            if nch == 3 {
+                                to[ncell + o] += dot(x_w);
+                                to[2 * ncell + o] += dot(z_w);
                             }
                         });
                     }
@@ -104,33 +123,68 @@ pub fn characterise(
         });
         let scale = 1.0 / ns as f64 / omega;
         for (dir, is_trans) in [(tdir, true), (rdir, false)] {
-            let mut data: Vec<f32> = Vec::with_capacity(n.pow(rank as u32));
-            for r in &rows {
-                let v = if is_trans { &r.0 } else { &r.1 };
-                data.extend(v.iter().map(|x| (x * scale) as f32));
-            }
-            // a rank-3 grid's upper half of incident cells stays empty (as rttree_reduce
-            // fills it with zeros)
-            data.resize(n.pow(rank as u32), 0.0);
-            if recip && (rank == 3 || !is_trans) {
-                reciprocity(rank, log2, &mut data);
-            }
-            let text = reduce(
-                &Grid {
-                    rank,
-                    log2,
-                    data: &data,
-                },
+            let comp = |r: &(Vec<f64>, Vec<f64>)| -> Vec<f64> {
+                if is_trans {
+                    r.0.clone()
+                } else {
+                    r.1.clone()
+                }
+            };
+            let rows_c: Vec<Vec<f64>> = rows.iter().map(comp).collect();
+            // Y / (π/N²); with +C also genBSDF's u′ and v′ of each cell (4/19 and 9/19
+            // where nothing arrives), culled at 100 − (100 − pct)/4
+            let mut trees = vec![(
+                Wavelength::Visible,
                 pctcull,
-            );
-            let tree = TensorTree::parse(rank, &text)
-                .map_err(|e| anyhow::anyhow!("internal: reduced tree does not parse: {e:?}"))?;
-            blocks.push(Block {
-                wavelength: Wavelength::Visible,
-                direction: dir,
-                data_type: "BTDF".into(),
-                data: BlockData::Tree(tree),
-            });
+                cell_values(&rows_c, ncell, |v, o| v[o] * scale),
+            )];
+            if opts.colour {
+                let uv = |v: &[f64], o: usize, u: bool| {
+                    let (x, y, z) = (v[ncell + o], v[o], v[2 * ncell + o]);
+                    let den = x + 15.0 * y + 3.0 * z;
+                    match (y != 0.0, u) {
+                        (true, true) => 4.0 * x / den,
+                        (true, false) => 9.0 * y / den,
+                        (false, true) => 4.0 / 19.0,
+                        (false, false) => 9.0 / 19.0,
+                    }
+                };
+                let pct_uv = 100.0 - (100.0 - pctcull) * 0.25;
+                trees.push((
+                    Wavelength::CieU,
+                    pct_uv,
+                    cell_values(&rows_c, ncell, |v, o| uv(v, o, true)),
+                ));
+                trees.push((
+                    Wavelength::CieV,
+                    pct_uv,
+                    cell_values(&rows_c, ncell, |v, o| uv(v, o, false)),
+                ));
+            }
+            for (wavelength, pct, mut data) in trees {
+                // a rank-3 grid's upper half of incident cells stays empty (as
+                // rttree_reduce fills it with zeros)
+                data.resize(n.pow(rank as u32), 0.0);
+                if recip && (rank == 3 || !is_trans) {
+                    reciprocity(rank, log2, &mut data);
+                }
+                let text = reduce(
+                    &Grid {
+                        rank,
+                        log2,
+                        data: &data,
+                    },
+                    pct,
+                );
+                let tree = TensorTree::parse(rank, &text)
+                    .map_err(|e| anyhow::anyhow!("internal: reduced tree does not parse: {e:?}"))?;
+                blocks.push(Block {
+                    wavelength,
+                    direction: dir,
+                    data_type: "BTDF".into(),
+                    data: BlockData::Tree(tree),
+                });
+            }
         }
     }
     let bsdf = Bsdf {
