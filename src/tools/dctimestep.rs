@@ -32,6 +32,21 @@ fn spec() -> Spec {
     .opt(Opt::new("if", Kind::Flag, "sky input is float"))
     .opt(Opt::new("id", Kind::Flag, "sky input is double"))
     .opt(Opt::new("h", Kind::Flag, "toggle the output header"))
+    .opt(Opt::new(
+        "Ev",
+        Kind::Word,
+        "standard errors of V (or of DC in the two-phase form), as rtcontrib -E writes them (fenestra)",
+    ))
+    .opt(Opt::new(
+        "Ed",
+        Kind::Word,
+        "standard errors of D, as rtcontrib -E writes them (fenestra)",
+    ))
+    .opt(Opt::new(
+        "Eo",
+        Kind::Word,
+        "write the standard error of every result value here (needs -Ev and/or -Ed; fenestra)",
+    ))
     .opt(Opt::new("x", Kind::Int, "output x resolution (reshape)"))
     .opt(Opt::new("y", Kind::Int, "output y resolution (reshape)"))
 }
@@ -51,6 +66,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     };
     let mut pos = Vec::new();
     let mut oc_given = false;
+    let (mut ev, mut ed, mut eo): (Option<String>, Option<String>, Option<String>) =
+        (None, None, None);
     for it in items {
         match it {
             Item::Pos(p) => pos.push(p),
@@ -74,6 +91,9 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 "if" => o.in_fmt = Some(DataFormat::Float),
                 "id" => o.in_fmt = Some(DataFormat::Double),
                 "h" => o.header = !o.header,
+                "Ev" => ev = Some(h.word().to_string()),
+                "Ed" => ed = Some(h.word().to_string()),
+                "Eo" => eo = Some(h.word().to_string()),
                 "x" | "y" => {
                     let v = h.int();
                     if v <= 0 {
@@ -148,6 +168,84 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         return picture_form(&vspec, td.map(|t| t.0), &sky, &o);
     }
     let td = td.map(|t| t.0);
+    if eo.is_none() && (ev.is_some() || ed.is_some()) {
+        bail!("-Ev/-Ed name the inputs' standard errors: give -Eo for the result's");
+    }
+    if let Some(out) = &eo {
+        if ev.is_none() && ed.is_none() {
+            bail!("-Eo needs the inputs' standard errors (-Ev for V or DC, -Ed for D)");
+        }
+        if ["-", ""].contains(&vspec.as_str()) || vspec.starts_with('!') {
+            bail!("-Eo needs V (or DC) as a file: it is read twice");
+        }
+        write_errors(
+            out,
+            &vspec,
+            td_specs.as_ref(),
+            ev.as_deref(),
+            ed.as_deref(),
+            &sky,
+            &o,
+        )?;
+    }
     matrix_form(v_reader, &vspec, td.as_ref(), td_specs.as_ref(), &sky, &o)?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// A matrix file as a planar matrix.
+fn planar(name: &str) -> Result<fenestra_dc::timestep::Planar> {
+    let m = fenestra_formats::matrix::Matrix::read(name)?;
+    fenestra_dc::timestep::Planar::from_interleaved(m.nrows, m.ncols, m.ncomp, &m.data)
+        .map_err(|e| anyhow::anyhow!("{name}: {e:#}"))
+}
+
+/// The standard errors of the result (fenestra's `-Eo`), same shape as the result.
+fn write_errors(
+    out: &str,
+    vspec: &str,
+    td: Option<&(String, String)>,
+    ev: Option<&str>,
+    ed: Option<&str>,
+    sky: &fenestra_dc::timestep::PackedSky,
+    o: &StepOptions,
+) -> Result<()> {
+    use fenestra_formats::matrix::{MatrixWriter, WriteOptions};
+    let v = planar(vspec)?;
+    let sv = ev.map(planar).transpose()?;
+    let e = match td {
+        Some((tname, dname)) => {
+            let t = fenestra_dc::steps::load_t(tname)?;
+            let d = planar(dname)?;
+            let sd = ed.map(planar).transpose()?;
+            fenestra_dc::errors::three_phase(&v, sv.as_ref(), &t, &d, sd.as_ref(), sky)?
+        }
+        None => {
+            if ed.is_some() {
+                bail!("-Ed: the two-phase form DC·s has no D (give DC's errors with -Ev)");
+            }
+            let sv = sv.expect("-Ev checked above");
+            fenestra_dc::errors::two_phase(&v, &sv, sky)?
+        }
+    };
+    let format = match o.out_fmt {
+        DataFormat::Float | DataFormat::Double => o.out_fmt,
+        _ => DataFormat::Ascii,
+    };
+    let mut wo = WriteOptions::with_command(format, &o.command);
+    if let Some(h) = wo.header.as_mut() {
+        h.push("CONTENTS= Monte Carlo standard error (1 sigma) of each value (independent V and D elements)");
+    }
+    let file = fenestra_cli::output::AtomicFile::create(out)?;
+    let mut w = MatrixWriter::new(file, Some(e.rows), e.cols, 3, &wo)?;
+    let mut row = vec![0.0; e.cols * 3];
+    for r in 0..e.rows {
+        for k in 0..e.cols {
+            for c in 0..3 {
+                row[k * 3 + c] = e.get(c, r, k);
+            }
+        }
+        w.write_row(&row)?;
+    }
+    w.finish()?.commit()?;
+    Ok(())
 }

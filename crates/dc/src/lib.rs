@@ -1,5 +1,6 @@
 //! fenestra-dc: daylight-coefficient algebra (V·T·D·s time stepping) and the matrix operations behind rmtxop.
 
+pub mod errors;
 pub mod ops;
 pub mod steps;
 pub mod timestep;
