@@ -106,3 +106,49 @@ fn oracle_two_window_groups_agree_with_rtrace() {
         "mean |d| {mean}, worst {worst}"
     );
 }
+
+#[test]
+fn climates_example_runs_and_reports_both_climates() {
+    // examples/climates/run.sh with the test build: two summary lines (Chicago, Melbourne),
+    // 45 sensors and 3650 occupied hours each, metrics within 0..100 %, and a per-sensor
+    // table of 45 rows per climate.
+    let exe = std::env::current_exe().unwrap();
+    let bin = exe
+        .parent()
+        .and_then(std::path::Path::parent)
+        .unwrap()
+        .to_path_buf();
+    let out_dir = common::scratch("climates");
+    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let out = std::process::Command::new("bash")
+        .arg(root.join("examples/climates/run.sh"))
+        .env("FENESTRA_BIN", &bin)
+        .env("OUT", &out_dir)
+        .env("FENESTRA_NO_PROGRESS", "1")
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    for name in ["chicago_tmy3", "melbourne_fl_tmy3"] {
+        let line = text
+            .lines()
+            .find(|l| l.starts_with(name))
+            .unwrap_or_else(|| panic!("{text}"));
+        assert!(line.contains("(45 sensors, 3650 occupied hours)"), "{line}");
+        let nums: Vec<f64> = line
+            .split_whitespace()
+            .filter_map(|w| w.parse::<f64>().ok())
+            .collect();
+        assert!(
+            nums.iter().take(4).all(|v| (0.0..=100.0).contains(v)),
+            "{line}"
+        );
+        let table = std::fs::read_to_string(out_dir.join(format!("{name}.metrics.txt"))).unwrap();
+        assert_eq!(table.lines().count(), 46, "{name}");
+    }
+    let _ = std::fs::remove_dir_all(&out_dir);
+}
