@@ -85,5 +85,8 @@ awk -v WEA=weather/sf_year.wea -v PTS=scene/sensors.pts '
   }
   END { if (row) printf "room: mean DA300 %.1f %% over %d sensors\n", 100 * da / row, row }
 ' "$out/ill.dat"
+hdr2png -o "$out/view_0321_1000.png" "$out/view_0321_1000.hdr" 2> /dev/null
+hdr2png -f auto -o "$out/view_0321_1000_falsecolor.png" "$out/view_0321_1000.hdr" 2> "$out/falsecolor_scale.txt"
 echo "picture of 21 March 10:00 (radiance through both windows, as seen from the back of the room): $out/view_0321_1000.hdr"
+echo "  the same as PNG: $out/view_0321_1000.png, in false colour: $out/view_0321_1000_falsecolor.png ($(cut -d: -f2- "$out/falsecolor_scale.txt"))"
 awk -v a="$start" -v b="$end" -v o="$out" 'BEGIN { printf "time for the pipeline (matrices, sky matrix, time steps, picture): %.2f s (results in %s)\n", b - a, o }'

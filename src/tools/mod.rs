@@ -12,6 +12,7 @@ pub mod genklemsamp;
 pub mod gensky;
 pub mod genskyvec;
 pub mod getinfo;
+pub mod hdr2png;
 pub mod mkillum;
 pub mod oconv;
 pub mod pcomb;
@@ -40,6 +41,7 @@ pub fn registry() -> &'static [(&'static str, Run)] {
         ("gensky", gensky::run),
         ("genskyvec", genskyvec::run),
         ("getinfo", getinfo::run),
+        ("hdr2png", hdr2png::run),
         ("mkillum", mkillum::run),
         ("oconv", oconv::run),
         ("pcomb", pcomb::run),

@@ -7,6 +7,7 @@ pub mod header;
 pub mod matrix;
 pub mod picture;
 pub mod picture_rle;
+pub mod png;
 pub mod resolution;
 pub mod rgbe;
 pub mod view;

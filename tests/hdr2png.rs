@@ -1,0 +1,86 @@
+//! hdr2png: a Radiance picture as a PNG: size and layout of the file, the stored rows
+//! (tone-mapped and false colour), and bad input.
+
+mod common;
+
+/// The IHDR size and the uncompressed scanlines of one of our PNGs (stored blocks).
+fn decode(png: &[u8]) -> (u32, u32, Vec<u8>) {
+    assert_eq!(&png[..8], &[0x89, b'P', b'N', b'G', 0x0d, 0x0a, 0x1a, 0x0a]);
+    let w = u32::from_be_bytes(png[16..20].try_into().unwrap());
+    let h = u32::from_be_bytes(png[20..24].try_into().unwrap());
+    assert_eq!(&png[24..29], &[8, 2, 0, 0, 0], "8-bit RGB");
+    let idat_len = u32::from_be_bytes(png[33..37].try_into().unwrap()) as usize;
+    assert_eq!(&png[37..41], b"IDAT");
+    let z = &png[41..41 + idat_len];
+    let mut raw = Vec::new();
+    let mut k = 2;
+    loop {
+        let last = z[k] & 1 == 1;
+        let len = u16::from_le_bytes([z[k + 1], z[k + 2]]) as usize;
+        raw.extend_from_slice(&z[k + 5..k + 5 + len]);
+        k += 5 + len;
+        if last {
+            break;
+        }
+    }
+    (w, h, raw)
+}
+
+#[test]
+fn pictures_become_pngs_of_the_same_size() {
+    let pic = common::fixture("threephase/img_t1_mar21_1000_clear.hdr");
+    let mut c = common::fenestra("hdr2png");
+    c.arg(&pic);
+    let out = c.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("exposure multiplier"));
+    let (w, h, raw) = decode(&out.stdout);
+    assert_eq!((w, h), (32, 26));
+    assert_eq!(raw.len(), 26 * (1 + 3 * 32));
+    assert!(
+        raw.chunks(1 + 3 * 32).all(|row| row[0] == 0),
+        "filter bytes"
+    );
+    // not all black, not all white
+    let px: Vec<u8> = raw.chunks(97).flat_map(|r| r[1..].to_vec()).collect();
+    assert!(px.iter().any(|&v| v > 20) && px.iter().any(|&v| v < 235));
+    // false colour: the scale on stderr, a pure ramp colour in every pixel (blue..red)
+    let mut c = common::fenestra("hdr2png");
+    c.args(["-f", "1000"]).arg(&pic);
+    let out = c.output().unwrap();
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("1000.0000 (red) cd/m2"));
+    let (_, _, raw) = decode(&out.stdout);
+    for row in raw.chunks(97) {
+        for p in row[1..].chunks(3) {
+            // the ramp has at most two of red, green, blue lit together, never all three
+            assert!(
+                p.iter().filter(|&&v| v > 0).count() <= 2 || p[0] == 0 || p[2] == 0,
+                "{p:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn bad_input_is_refused() {
+    let dir = common::scratch("hdr2png-bad");
+    std::fs::write(dir.join("not.hdr"), "hello\n").unwrap();
+    for args in [
+        &["not.hdr"][..],
+        &["missing.hdr"],
+        &["-g", "0", "not.hdr"],
+        &["-q"],
+    ] {
+        let mut c = common::fenestra("hdr2png");
+        c.args(args).current_dir(&dir);
+        let out = c.output().unwrap();
+        assert!(!out.status.success(), "{args:?}");
+        assert!(out.stdout.is_empty(), "{args:?}: nothing written");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
