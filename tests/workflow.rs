@@ -197,3 +197,43 @@ fn matrices_script_writes_v_and_d() {
         assert_eq!(values(&d).len(), 145);
     }
 }
+
+/// The matrices bundled in examples/three-phase/matrices are what matrices.sh writes at its
+/// defaults: same numbers (headers differ only in dates and the output path). Fails when an
+/// engine change alters them, so that they are regenerated with it.
+#[test]
+fn bundled_matrices_are_what_the_script_writes() {
+    let dir = office("workflow-bundled");
+    std::fs::copy(
+        repo().join("examples/three-phase/matrices.sh"),
+        dir.join("matrices.sh"),
+    )
+    .unwrap();
+    let out = sh(
+        &dir,
+        "FENESTRA_BIN=\"$(dirname \"$(command -v rtcontrib)\")\" bash ./matrices.sh out",
+    );
+    assert!(
+        out.status.success(),
+        "matrices.sh failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let data = |p: PathBuf| {
+        let text = std::fs::read_to_string(&p).unwrap();
+        text.split_once("\n\n").expect("header then data").1.to_string()
+    };
+    for f in [
+        "V_SouthGroup.vmx",
+        "V_WestGroup.vmx",
+        "D_SouthGroup.dmx",
+        "D_WestGroup.dmx",
+    ] {
+        let fresh = data(dir.join("out").join(f));
+        let bundled = data(repo().join("examples/three-phase/matrices").join(f));
+        assert!(
+            fresh == bundled,
+            "{f}: the bundled matrix is not what matrices.sh writes now; regenerate it \
+             (examples/three-phase/matrices/README.md)"
+        );
+    }
+}
