@@ -51,6 +51,7 @@ fn in_process(dir: &std::path::Path, count: usize, stream: bool, name: &str) {
         count,
         errors: false,
         batches: 4,
+        replicas: 0,
     };
     let spec = Spec::parse(dir.join(name).to_str().unwrap()).unwrap();
     let plans = output::plan(
@@ -77,6 +78,7 @@ fn in_process(dir: &std::path::Path, count: usize, stream: bool, name: &str) {
     let mut out = run::Outputs {
         values,
         errors: Vec::new(),
+        replicas: Vec::new(),
         format: Format::Ascii,
     };
     let pool = fenestra_cli::threads::pool(2).unwrap();

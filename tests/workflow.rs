@@ -220,7 +220,10 @@ fn bundled_matrices_are_what_the_script_writes() {
     );
     let data = |p: PathBuf| {
         let text = std::fs::read_to_string(&p).unwrap();
-        text.split_once("\n\n").expect("header then data").1.to_string()
+        text.split_once("\n\n")
+            .expect("header then data")
+            .1
+            .to_string()
     };
     for f in [
         "V_SouthGroup.vmx",

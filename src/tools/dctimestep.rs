@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Result};
 use fenestra_cli::opts::{Item, Kind, Opt, Spec};
+use fenestra_dc::errors::Uncertainty;
 use fenestra_dc::steps::{load_td, matrix_form, picture_form, read_sky, StepOptions};
 use fenestra_formats::matrix::{DataFormat, MatrixReader};
 
@@ -43,9 +44,19 @@ fn spec() -> Spec {
         "standard errors of D, as rtcontrib -E writes them (fenestra)",
     ))
     .opt(Opt::new(
+        "Rv",
+        Kind::Word,
+        "replicas of V (or of DC), as rtcontrib -E -Er K writes them: errors with every covariance (fenestra)",
+    ))
+    .opt(Opt::new(
+        "Rd",
+        Kind::Word,
+        "replicas of D, as rtcontrib -E -Er K writes them (fenestra)",
+    ))
+    .opt(Opt::new(
         "Eo",
         Kind::Word,
-        "write the standard error of every result value here (needs -Ev and/or -Ed; fenestra)",
+        "write the standard error of every result value here (needs -Ev/-Rv and/or -Ed/-Rd; fenestra)",
     ))
     .opt(Opt::new("x", Kind::Int, "output x resolution (reshape)"))
     .opt(Opt::new("y", Kind::Int, "output y resolution (reshape)"))
@@ -68,6 +79,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let mut oc_given = false;
     let (mut ev, mut ed, mut eo): (Option<String>, Option<String>, Option<String>) =
         (None, None, None);
+    let (mut rv, mut rd): (Option<String>, Option<String>) = (None, None);
     for it in items {
         match it {
             Item::Pos(p) => pos.push(p),
@@ -94,6 +106,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 "Ev" => ev = Some(h.word().to_string()),
                 "Ed" => ed = Some(h.word().to_string()),
                 "Eo" => eo = Some(h.word().to_string()),
+                "Rv" => rv = Some(h.word().to_string()),
+                "Rd" => rd = Some(h.word().to_string()),
                 "x" | "y" => {
                     let v = h.int();
                     if v <= 0 {
@@ -168,25 +182,29 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         return picture_form(&vspec, td.map(|t| t.0), &sky, &o);
     }
     let td = td.map(|t| t.0);
-    if eo.is_none() && (ev.is_some() || ed.is_some()) {
-        bail!("-Ev/-Ed name the inputs' standard errors: give -Eo for the result's");
+    if eo.is_none() && (ev.is_some() || ed.is_some() || rv.is_some() || rd.is_some()) {
+        bail!("-Ev/-Ed/-Rv/-Rd describe the inputs' errors: give -Eo for the result's");
+    }
+    if ev.is_some() && rv.is_some() {
+        bail!("-Ev and -Rv both describe V's errors: give one (-Rv, the replicas, is exact)");
+    }
+    if ed.is_some() && rd.is_some() {
+        bail!("-Ed and -Rd both describe D's errors: give one (-Rd, the replicas, is exact)");
     }
     if let Some(out) = &eo {
-        if ev.is_none() && ed.is_none() {
-            bail!("-Eo needs the inputs' standard errors (-Ev for V or DC, -Ed for D)");
+        if ev.is_none() && ed.is_none() && rv.is_none() && rd.is_none() {
+            bail!("-Eo needs the inputs' errors (-Ev or -Rv for V or DC, -Ed or -Rd for D)");
         }
         if ["-", ""].contains(&vspec.as_str()) || vspec.starts_with('!') {
             bail!("-Eo needs V (or DC) as a file: it is read twice");
         }
-        write_errors(
-            out,
-            &vspec,
-            td_specs.as_ref(),
-            ev.as_deref(),
-            ed.as_deref(),
-            &sky,
-            &o,
-        )?;
+        let ins = ErrorInputs {
+            ev: ev.as_deref(),
+            ed: ed.as_deref(),
+            rv: rv.as_deref(),
+            rd: rd.as_deref(),
+        };
+        write_errors(out, &vspec, td_specs.as_ref(), &ins, &sky, &o)?;
     }
     matrix_form(v_reader, &vspec, td.as_ref(), td_specs.as_ref(), &sky, &o)?;
     Ok(ExitCode::SUCCESS)
@@ -199,33 +217,72 @@ fn planar(name: &str) -> Result<fenestra_dc::timestep::Planar> {
         .map_err(|e| anyhow::anyhow!("{name}: {e:#}"))
 }
 
+/// The files that describe V's and D's errors (`-Ev -Ed -Rv -Rd`).
+struct ErrorInputs<'a> {
+    ev: Option<&'a str>,
+    ed: Option<&'a str>,
+    rv: Option<&'a str>,
+    rd: Option<&'a str>,
+}
+
+/// A matrix's errors from its standard-error file or its replica file.
+fn uncertainty(se: Option<&str>, rep: Option<&str>) -> Result<Uncertainty> {
+    if let Some(name) = rep {
+        let m = fenestra_formats::matrix::Matrix::read(name)?;
+        let k: usize = match m.header.get("NREPLICAS") {
+            Some(v) => v.trim().parse().map_err(|_| {
+                anyhow::anyhow!("{name}: NREPLICAS={v} is not a number of replicas")
+            })?,
+            None => bail!(
+                "{name}: no NREPLICAS= line in the header: not a replica file of rtcontrib -Er"
+            ),
+        };
+        let all =
+            fenestra_dc::timestep::Planar::from_interleaved(m.nrows, m.ncols, m.ncomp, &m.data)
+                .map_err(|e| anyhow::anyhow!("{name}: {e:#}"))?;
+        return Uncertainty::replicas(&all, k, name);
+    }
+    Ok(match se {
+        Some(name) => Uncertainty::Independent(planar(name)?),
+        None => Uncertainty::Exact,
+    })
+}
+
 /// The standard errors of the result (fenestra's `-Eo`), same shape as the result.
 fn write_errors(
     out: &str,
     vspec: &str,
     td: Option<&(String, String)>,
-    ev: Option<&str>,
-    ed: Option<&str>,
+    ins: &ErrorInputs,
     sky: &fenestra_dc::timestep::PackedSky,
     o: &StepOptions,
 ) -> Result<()> {
     use fenestra_formats::matrix::{MatrixWriter, WriteOptions};
     let v = planar(vspec)?;
-    let sv = ev.map(planar).transpose()?;
+    let uv = uncertainty(ins.ev, ins.rv)?;
     let e = match td {
         Some((tname, dname)) => {
             let t = fenestra_dc::steps::load_t(tname)?;
             let d = planar(dname)?;
-            let sd = ed.map(planar).transpose()?;
-            fenestra_dc::errors::three_phase(&v, sv.as_ref(), &t, &d, sd.as_ref(), sky)?
+            let ud = uncertainty(ins.ed, ins.rd)?;
+            fenestra_dc::errors::three_phase(&v, &uv, &t, &d, &ud, sky)?
         }
         None => {
-            if ed.is_some() {
-                bail!("-Ed: the two-phase form DC·s has no D (give DC's errors with -Ev)");
+            if ins.ed.is_some() || ins.rd.is_some() {
+                bail!(
+                    "-Ed/-Rd: the two-phase form DC·s has no D (give DC's errors with -Ev or -Rv)"
+                );
             }
-            let sv = sv.expect("-Ev checked above");
-            fenestra_dc::errors::two_phase(&v, &sv, sky)?
+            fenestra_dc::errors::two_phase(&v, &uv, sky)?
         }
+    };
+    let model = match (
+        ins.rv.is_some() || ins.rd.is_some(),
+        ins.ev.is_some() || ins.ed.is_some(),
+    ) {
+        (true, false) => "from replicas",
+        (true, true) => "from replicas and independent elements",
+        _ => "independent V and D elements: an upper bound",
     };
     let format = match o.out_fmt {
         DataFormat::Float | DataFormat::Double => o.out_fmt,
@@ -233,7 +290,9 @@ fn write_errors(
     };
     let mut wo = WriteOptions::with_command(format, &o.command);
     if let Some(h) = wo.header.as_mut() {
-        h.push("CONTENTS= Monte Carlo standard error (1 sigma) of each value (independent V and D elements)");
+        h.push(format!(
+            "CONTENTS= Monte Carlo standard error (1 sigma) of each value ({model})"
+        ));
     }
     let file = fenestra_cli::output::AtomicFile::create(out)?;
     let mut w = MatrixWriter::new(file, Some(e.rows), e.cols, 3, &wo)?;

@@ -14,7 +14,7 @@ use fenestra_trace::{TraceOptions, Tracer};
 /// Most bins one modifier may have (2^24: 400 MiB of sums per thread).
 const MAX_BINS: usize = 1 << 24;
 
-const USAGE: &str = "[-n N][-V][-I|-i][-c N][-f{a,f,d}{a,f,d,c}][-fo|-r][-x X -y Y][-o spec][-E][-Eo spec][-Eb N][-p a=1,..][-e expr][-f file.cal][-b binexpr][-bn N] {-m mod | -M file} .. [-ab N -ad N -lw W -lr N -ds V -dj V -st V -ss V -bv -seed N ..] scene.{oct,rad} ..";
+const USAGE: &str = "[-n N][-V][-I|-i][-c N][-f{a,f,d}{a,f,d,c}][-fo|-r][-x X -y Y][-o spec][-E][-Eo spec][-Eb N][-Er K][-p a=1,..][-e expr][-f file.cal][-b binexpr][-bn N] {-m mod | -M file} .. [-ab N -ad N -lw W -lr N -ds V -dj V -st V -ss V -bv -seed N ..] scene.{oct,rad} ..";
 
 struct ModArg {
     name: String,
@@ -83,6 +83,7 @@ pub fn run_with(
     let mut limit_dist = false;
     let mut count = 1usize;
     let (mut xres, mut yres, mut nproc, mut batches) = (0usize, 0usize, 1usize, 4usize);
+    let mut replicas = 0usize;
     let (mut fin, mut fout) = (InFormat::Ascii, Format::Ascii);
     let mut defs = CalcDefs::new();
     let mut cur_spec: Option<Spec> = None;
@@ -177,6 +178,9 @@ pub fn run_with(
                 format!("-I{}\t\t\t\t# irradiance (point and normal input)", pm(irr)),
                 format!("-E{}\t\t\t\t# standard errors (fenestra)", pm(errors)),
                 format!("-Eb {batches:<8}\t\t# replicas per record for -E with -c 1 (fenestra)"),
+                format!(
+                    "-Er {replicas:<8}\t\t# replica rows written per record, 0: none (fenestra)"
+                ),
                 format!("-bv{}\t\t\t\t# back face visibility", pm(o.bv)),
                 "-dt 0.000000\t\t\t# direct threshold (forced)".to_string(),
                 format!("-dc {:.6}\t\t\t# direct certainty (accepted)", o.dc),
@@ -255,6 +259,13 @@ pub fn run_with(
                 "o" => cur_spec = Some(Spec::parse(word(&args, i + 1)?)?),
                 "Eo" => cur_err = Some(Spec::parse(word(&args, i + 1)?)?),
                 "Eb" => batches = (num(&args, i + 1)?.max(2.0)) as usize,
+                "Er" => {
+                    let k = num(&args, i + 1)?;
+                    if !(2.0..=4096.0).contains(&k) || k.fract() != 0.0 {
+                        bail!("-Er: the number of replicas must be a whole number from 2 to 4096, not {k}");
+                    }
+                    replicas = k as usize;
+                }
                 "p" => {
                     cur_params = parse_params(word(&args, i + 1)?)?;
                     defs.push_params(&cur_params);
@@ -413,6 +424,25 @@ pub fn run_with(
     }
     // -ld+ (not with -I, which ignores the length as Radiance does)
     let limit = limit_dist && !irr;
+    if replicas > 0 {
+        if !errors {
+            bail!("-Er writes replicas beside the standard errors: give -E too");
+        }
+        if count == 0 {
+            bail!("-Er with -c 0: the single sum has no replicas (give -c N)");
+        }
+        if count > 1 && count < replicas {
+            bail!(
+                "-Er {replicas}: each replica needs at least one of the record's rays (-c {count})"
+            );
+        }
+        if recover {
+            bail!("-Er with -r: replicas cannot be continued from an interrupted run");
+        }
+        if xres > 0 && yres > 0 {
+            bail!("-Er: pictures have no replicas (give -x 0 or -y 0)");
+        }
+    }
 
     // Input.
     let expect = if yres > 0 {
@@ -440,6 +470,7 @@ pub fn run_with(
         count,
         errors,
         batches,
+        replicas,
     };
     // rtcontrib without -bn: a first pass over the input finds the bins each such
     // modifier reaches
@@ -499,6 +530,31 @@ pub fn run_with(
     } else {
         Vec::new()
     };
+    // -Er: replicas go beside each error file, its name ending .rep instead of .err
+    let rep_specs: Vec<Spec> = if replicas > 0 {
+        err_specs
+            .iter()
+            .map(|e| {
+                if e.text.starts_with('!') {
+                    bail!("-Er: replicas are written to files; the standard errors go to a command ({})", e.text);
+                }
+                let base = e.text.strip_suffix(".err").unwrap_or(&e.text);
+                Spec::parse(&format!("{base}.rep"))
+            })
+            .collect::<Result<_>>()?
+    } else {
+        Vec::new()
+    };
+    let rep_outs: Vec<ModOut> = mods
+        .iter()
+        .zip(&rep_specs)
+        .map(|(m, s)| ModOut {
+            name: &m.name,
+            spec: Some(s),
+            nbins: m.nbins,
+        })
+        .collect();
+    let rep_plans = output::plan(&rep_outs, false);
     if recover && overwrite {
         bail!("options -r and -fo are mutually exclusive");
     }
@@ -540,11 +596,16 @@ pub fn run_with(
     } else if !reload {
         output::check_files(&plans, overwrite)?;
         output::check_files(&err_plans, overwrite)?;
+        output::check_files(&rep_plans, overwrite)?;
     }
-    for p in &err_plans {
-        if plans.iter().any(|q| q.name == p.name) {
+    for p in err_plans.iter().chain(&rep_plans) {
+        if plans
+            .iter()
+            .chain(&err_plans)
+            .any(|q| q.name == p.name && !std::ptr::eq(p, q))
+        {
             bail!(
-                "-E: the standard errors would go to '{}', which also receives values",
+                "-E: the standard errors or replicas would go to '{}', which also receives other values",
                 p.name.as_deref().unwrap_or("standard output")
             );
         }
@@ -561,6 +622,11 @@ pub fn run_with(
     };
     let mut err_info = info.clone();
     err_info.extra = vec!["CONTENTS= Monte Carlo standard error (1 sigma) of each value".into()];
+    let mut rep_info = info.clone();
+    rep_info.extra = vec![
+        format!("CONTENTS= {replicas} independent replica estimates per record, one row each; their mean is the value"),
+        format!("NREPLICAS={replicas}"),
+    ];
     let nplans = plans.len();
     let open = |k: usize, p: output::StreamPlan, info: &HeaderInfo| -> Result<Stream> {
         match parts.get(k).copied().flatten() {
@@ -578,9 +644,14 @@ pub fn run_with(
         .enumerate()
         .map(|(k, p)| open(nplans + k, p, &err_info))
         .collect::<Result<_>>()?;
+    let rep_streams: Vec<Stream> = rep_plans
+        .into_iter()
+        .map(|p| Stream::open(p, &rep_info))
+        .collect::<Result<_>>()?;
     let mut out = contrib_run::Outputs {
         values,
         errors: err_streams,
+        replicas: rep_streams,
         format: fout,
     };
 

@@ -110,6 +110,10 @@ pub struct RunOptions {
     pub errors: bool,
     /// With `-c 1` and errors: independent batches per ray (the value is their mean).
     pub batches: usize,
+    /// Replicas per record (`-Er K`, needs errors; 0: none): the rays of a record in K
+    /// interleaved groups (ray j in group j mod K; with `-c 1`, K batches), each group's
+    /// estimate written as a row, so that a later product can measure its own variance.
+    pub replicas: usize,
     /// `-ld+`: rays end at the length of their direction vector (transmitted rays carry
     /// the rest on).
     pub limit_dist: bool,
@@ -124,6 +128,9 @@ pub struct Record {
     pub scale: f64,
     /// Standard errors of the values (`sums × scale`), with `-E`.
     pub errors: Option<Vec<f64>>,
+    /// With `-Er K`: K replica estimates, `3 × total bins` each, one after the other;
+    /// their mean is the value.
+    pub replicas: Option<Vec<f64>>,
 }
 
 /// The contribution tracer.
@@ -144,6 +151,8 @@ pub struct Engine<'a> {
 struct Acc {
     sum: Vec<f64>,
     sumsq: Vec<f64>,
+    /// Per-replica sums (`replicas × 3 × total bins`), with `-Er`.
+    rep: Vec<f64>,
     n: usize,
 }
 
@@ -321,8 +330,10 @@ impl<'a> Engine<'a> {
             if scratch.tmp.len() != n3 {
                 scratch.tmp = vec![0.0; n3];
             }
+            a.rep = vec![0.0; n3 * self.opts.replicas];
         }
-        for (idx, r) in rays {
+        let nrep = self.opts.replicas;
+        for (j, (idx, r)) in rays.enumerate() {
             a.n += 1;
             if self.opts.errors {
                 // only the slots this ray reached are added (adding zeros would not
@@ -331,6 +342,14 @@ impl<'a> Engine<'a> {
                 let mut touched = std::mem::take(&mut scratch.touched);
                 touched.clear();
                 self.trace_one(idx, &r, &mut tmp, Some(&mut touched), scratch);
+                if nrep > 0 {
+                    let rep = &mut a.rep[(j % nrep) * n3..][..n3];
+                    for &s in &touched {
+                        for c in s..s + 3 {
+                            rep[c] += tmp[c];
+                        }
+                    }
+                }
                 for &s in &touched {
                     let sums = a.sum[s..s + 3].iter_mut().zip(&mut a.sumsq[s..s + 3]);
                     for ((sum, sq), t) in sums.zip(&mut tmp[s..s + 3]) {
@@ -375,10 +394,16 @@ impl<'a> Engine<'a> {
         } else {
             None
         };
+        // replica k's estimate is K/n times its group's sum, so that their mean is the value
+        let replicas = (self.opts.replicas > 0 && !sum_only).then(|| {
+            let f = self.opts.replicas as f64 / n;
+            a.rep.iter().map(|v| v * f).collect()
+        });
         Record {
             sums: a.sum,
             scale: if sum_only { 1.0 } else { 1.0 / n },
             errors,
+            replicas,
         }
     }
 
@@ -410,7 +435,11 @@ impl<'a> Engine<'a> {
     ) -> Result<Vec<Record>> {
         let c = self.opts.count.max(1);
         let batches = if self.opts.errors && c == 1 {
-            self.opts.batches.max(2)
+            if self.opts.replicas > 0 {
+                self.opts.replicas
+            } else {
+                self.opts.batches.max(2)
+            }
         } else {
             1
         };

@@ -19,6 +19,8 @@ pub struct Outputs {
     pub values: Vec<Stream>,
     /// Standard-error streams (empty without `-E`).
     pub errors: Vec<Stream>,
+    /// Replica streams (empty without `-Er`): K rows per record.
+    pub replicas: Vec<Stream>,
     /// Data format of every stream.
     pub format: Format,
 }
@@ -40,12 +42,24 @@ impl Outputs {
                 })?;
             }
         }
+        if let Some(r) = &rec.replicas {
+            let n3 = rec.sums.len();
+            for s in self.replicas.iter_mut() {
+                for rep in r.chunks(n3.max(1)) {
+                    s.write_record(self.format, 1.0, |m, b| {
+                        let k = engine.slot(m, b) * 3;
+                        [rep[k], rep[k + 1], rep[k + 2]]
+                    })?;
+                }
+            }
+        }
         Ok(())
     }
 
     /// Flushes every stream (a record boundary where Radiance flushes).
     pub fn flush(&mut self) -> Result<()> {
-        for s in self.values.iter_mut().chain(self.errors.iter_mut()) {
+        let all = self.values.iter_mut().chain(self.errors.iter_mut());
+        for s in all.chain(self.replicas.iter_mut()) {
             s.flush()?;
         }
         Ok(())
@@ -53,7 +67,12 @@ impl Outputs {
 
     /// Closes every stream (files move into place, commands are waited for).
     pub fn finish(self) -> Result<()> {
-        for s in self.values.into_iter().chain(self.errors) {
+        for s in self
+            .values
+            .into_iter()
+            .chain(self.errors)
+            .chain(self.replicas)
+        {
             s.finish()?;
         }
         Ok(())
