@@ -152,3 +152,63 @@ fn climates_example_runs_and_reports_both_climates() {
     }
     let _ = std::fs::remove_dir_all(&out_dir);
 }
+
+#[test]
+fn main_example_runs_with_error_bands() {
+    // examples/three-phase/run.sh (the README's main command) with the test build: fresh
+    // matrices with replicas, the annual time steps with their standard errors, dametrics'
+    // table of 45 sensors with bands that contain each metric, the picture as PNG.
+    let exe = std::env::current_exe().unwrap();
+    let bin = exe
+        .parent()
+        .and_then(std::path::Path::parent)
+        .unwrap()
+        .to_path_buf();
+    let out_dir = common::scratch("three-phase-main");
+    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let out = std::process::Command::new("bash")
+        .arg(root.join("examples/three-phase/run.sh"))
+        .env("FENESTRA_BIN", &bin)
+        .env("OUT", &out_dir)
+        .env("FENESTRA_NO_PROGRESS", "1")
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let table = std::fs::read_to_string(out_dir.join("metrics.txt")).unwrap();
+    let lines: Vec<&str> = table.lines().collect();
+    assert_eq!(lines.len(), 47, "{table}");
+    assert!(
+        lines[0].contains("DA ±2σ") && lines[0].contains("lux se≤"),
+        "{}",
+        lines[0]
+    );
+    for l in &lines[1..46] {
+        // sensor x y DA UDI mean DAlo–DAhi flip UDIlo–UDIhi flip se
+        let w: Vec<&str> = l.split_whitespace().collect();
+        assert_eq!(w.len(), 11, "{l}");
+        let num = |s: &str| s.parse::<f64>().unwrap();
+        let band = |s: &str| {
+            let (a, b) = s.split_once('–').unwrap();
+            (num(a), num(b))
+        };
+        let (da, udi, se) = (num(w[3]), num(w[4]), num(w[10]));
+        let (dlo, dhi) = band(w[6]);
+        let (ulo, uhi) = band(w[8]);
+        assert!(dlo <= da && da <= dhi && ulo <= udi && udi <= uhi, "{l}");
+        assert!(se > 0.0 && num(w[5]) > 0.0, "{l}");
+    }
+    assert!(lines[46].starts_with("room: sDA300/50%"), "{}", lines[46]);
+    for f in [
+        "ill.dat",
+        "ill_south.err",
+        "ill_west.err",
+        "view_0321_1000.png",
+    ] {
+        assert!(out_dir.join(f).is_file(), "{f}");
+    }
+    let _ = std::fs::remove_dir_all(&out_dir);
+}

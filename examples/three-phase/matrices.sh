@@ -8,9 +8,11 @@
 #        genklemsamp … window_out.rad | rtcontrib -c N … -b rbin -m skyglow   (and window_west_out.rad)
 #
 # Usage: examples/three-phase/matrices.sh [OUTDIR]      (default: examples/three-phase/out/matrices)
-# Settings (environment): V_OPTS (default "-ab 6 -ad 50000 -lw 2e-5"), D_OPTS ("-ab 2 -ad 1000 -lw 1e-4"),
-# D_C (rays per Klems patch, 1000) — the parameters of the reference matrices in matrices/; FENESTRA_BIN=dir to use
-# already-built binaries instead of building them.
+# Settings (environment): V_OPTS (default "-ab 6 -ad 6250 -lw 2e-5", traced REPLICAS times per sensor: 50 000
+# ambient samples in all), D_OPTS ("-ab 2 -ad 1000 -lw 1e-4"), D_C (rays per Klems patch, 1000) — the parameters of
+# the matrices in matrices/; REPLICAS (8; 0: none) independent replicas per record written beside each matrix
+# (X.err: standard errors, X.rep: replicas, for dctimestep -Rv/-Rd); FENESTRA_BIN=dir to use already-built binaries
+# instead of building them.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 top=$(cd "$here/../.." && pwd)
@@ -23,7 +25,10 @@ if [ -z "${FENESTRA_BIN:-}" ]; then
 fi
 export PATH="$FENESTRA_BIN:$PATH"
 nproc=$(nproc 2>/dev/null || echo 2)
-V_OPTS=${V_OPTS:--ab 6 -ad 50000 -lw 2e-5}
+V_OPTS=${V_OPTS:--ab 6 -ad 6250 -lw 2e-5}
+REPLICAS=${REPLICAS:-8}
+err=()
+if [ "$REPLICAS" -gt 0 ]; then err=(-E -Er "$REPLICAS"); fi
 D_OPTS=${D_OPTS:--ab 2 -ad 1000 -lw 1e-4}
 D_C=${D_C:-1000}
 out=${1:-$here/out/matrices}
@@ -34,7 +39,7 @@ cd "$here/scene"
 echo "== V: rtcontrib -I+ $V_OPTS … -b kbinS -m SouthGroup -b kbinW -m WestGroup < sensors.pts" >&2
 oconv materials.rad room.rad window_vmx.rad window_west_vmx.rad > "$out/vmx.oct"
 # shellcheck disable=SC2086  # the option strings are meant to be split
-rtcontrib -n "$nproc" -fo -I+ $V_OPTS -faa -f klems_full.cal -bn Nkbins -o "$out/V_%s.vmx" \
+rtcontrib -n "$nproc" -fo -I+ $V_OPTS "${err[@]}" -faa -f klems_full.cal -bn Nkbins -o "$out/V_%s.vmx" \
   -b kbinS -m SouthGroup -b kbinW -m WestGroup "$out/vmx.oct" < sensors.pts
 
 oconv materials.rad room.rad exterior.rad sky_dmx.rad > "$out/dmx.oct"
@@ -44,7 +49,8 @@ for group in "SouthGroup window_out.rad 0 -1 0" "WestGroup window_west_out.rad -
   echo "== D $1: genklemsamp -c $D_C -vd $3 $4 $5 $2 | rtcontrib -c $D_C $D_OPTS … -b rbin -m skyglow" >&2
   # shellcheck disable=SC2086
   genklemsamp -ff -c "$D_C" -vd "$3" "$4" "$5" -vu 0 0 1 "$2" |
-    rtcontrib -n "$nproc" -c "$D_C" -ffa $D_OPTS -e MF:1 -f reinhart.cal -b rbin -bn Nrbins -m skyglow "$out/dmx.oct" \
-    > "$out/D_$1.dmx"
+    rtcontrib -n "$nproc" -fo -c "$D_C" -ffa $D_OPTS "${err[@]}" -e MF:1 -f reinhart.cal -b rbin -bn Nrbins \
+      -o "$out/D_$1.dmx" -m skyglow "$out/dmx.oct"
 done
 echo "V_SouthGroup.vmx, V_WestGroup.vmx, D_SouthGroup.dmx, D_WestGroup.dmx written to $out" >&2
+if [ "$REPLICAS" -gt 0 ]; then echo "  with their standard errors (.err) and $REPLICAS replicas per record (.rep)" >&2; fi

@@ -5,7 +5,9 @@
 #   sky matrix s   gendaymtx -m 1 weather/sf_year.wea                     (146 Reinhart patches x 8760 hours)
 #   time step      per window group dctimestep V T D s, summed by rmtxop, -c … to lux (45 sensors x 8760 hours):
 #                  south window with a venetian blind (blinds_kf.xml), west window with clear glass (clear_glass_kf.xml)
-#   metrics        per sensor: daylight autonomy (share of working hours 8-18 h with >= 300 lux), mean lux
+#   metrics        dametrics: per sensor DA300, UDI 100-2000 and mean lux over working hours (8-18 h), sDA300/50%;
+#                  with fresh matrices also how far each can move within 2 standard errors of every hour (the
+#                  errors from the matrices' replicas: dctimestep -Rv -Rd -Eo)
 #
 #   phases I, II   matrices.sh: V (room → window, Klems) with rtcontrib -I, D (window → sky, Reinhart MF 1) with
 #                  genklemsamp | rtcontrib, per window group (scene/); matrices/ holds the same at these settings
@@ -40,8 +42,15 @@ fi
 echo "== sky matrix: gendaymtx -m 1 weather/sf_year.wea" >&2
 gendaymtx -m 1 weather/sf_year.wea > "$out/sky.smx"
 echo "== time step: dctimestep V T D sky per window group (south: blind, west: clear), summed, to lux" >&2
-rmtxop -ff "!dctimestep $m/V_SouthGroup.vmx matrices/blinds_kf.xml $m/D_SouthGroup.dmx $out/sky.smx" \
-  + "!dctimestep $m/V_WestGroup.vmx matrices/clear_glass_kf.xml $m/D_WestGroup.dmx $out/sky.smx" |
+# with the matrices' replicas (matrices.sh writes them), each group's standard errors too
+es="" ew="" errs=()
+if [ -f "$m/V_SouthGroup.vmx.rep" ] && [ -f "$m/D_SouthGroup.dmx.rep" ]; then
+  es="-Rv $m/V_SouthGroup.vmx.rep -Rd $m/D_SouthGroup.dmx.rep -Eo $out/ill_south.err"
+  ew="-Rv $m/V_WestGroup.vmx.rep -Rd $m/D_WestGroup.dmx.rep -Eo $out/ill_west.err"
+  errs=(-E "$out/ill_south.err" -E "$out/ill_west.err")
+fi
+rmtxop -ff "!dctimestep $es $m/V_SouthGroup.vmx matrices/blinds_kf.xml $m/D_SouthGroup.dmx $out/sky.smx" \
+  + "!dctimestep $ew $m/V_WestGroup.vmx matrices/clear_glass_kf.xml $m/D_WestGroup.dmx $out/sky.smx" |
   rmtxop -fa -c 47.435 119.93 11.635 - > "$out/ill.dat"
 
 echo "== one moment as a picture: V per pixel (vwrays | rtcontrib -ffc, both groups), dctimestep per group, pcomb" >&2
@@ -62,29 +71,7 @@ pcomb "!dctimestep $out/vimg/SouthGroup_%03d.hdr matrices/blinds_kf.xml $m/D_Sou
 end=$(date +%s.%N)
 
 echo "== annual metrics per sensor (working hours 8-18 h local standard time)"
-# Column k of ill.dat is hour k of the weather file; keep the working ones.
-awk -v WEA=weather/sf_year.wea -v PTS=scene/sensors.pts '
-  BEGIN {
-    n = 0
-    while ((getline line < WEA) > 0) {
-      split(line, f, /[ \t]+/)
-      if (f[1] ~ /^[0-9]+$/ && f[2] ~ /^[0-9]+$/ && f[3] != "") { n++; work[n] = (f[3] >= 8 && f[3] < 18) }
-    }
-    s = 0
-    while ((getline line < PTS) > 0) { split(line, p, /[ \t]+/); s++; px[s] = p[1]; py[s] = p[2] }
-    printf "%-7s %6s %6s %10s %10s\n", "sensor", "x", "y", "DA300 %", "mean lux"
-    body = 0; row = 0
-  }
-  body == 0 { if ($0 == "") body = 1; next }
-  NF > 0 {
-    row++; nw = 0; above = 0; sum = 0
-    for (k = 1; k <= NF; k++) if (work[k]) { nw++; sum += $k; if ($k >= 300) above++ }
-    if (NF != n) { printf "run.sh: %d values for sensor %d, expected %d hours\n", NF, row, n > "/dev/stderr"; exit 1 }
-    printf "%-7d %6.2f %6.2f %10.1f %10.1f\n", row, px[row], py[row], 100 * above / nw, sum / nw
-    da += above / nw
-  }
-  END { if (row) printf "room: mean DA300 %.1f %% over %d sensors\n", 100 * da / row, row }
-' "$out/ill.dat"
+dametrics -w weather/sf_year.wea -o 8 18 -p scene/sensors.pts "${errs[@]}" "$out/ill.dat" | tee "$out/metrics.txt"
 hdr2png -o "$out/view_0321_1000.png" "$out/view_0321_1000.hdr" 2> /dev/null
 hdr2png -f auto -o "$out/view_0321_1000_falsecolor.png" "$out/view_0321_1000.hdr" 2> "$out/falsecolor_scale.txt"
 echo "picture of 21 March 10:00 (radiance through both windows, as seen from the back of the room): $out/view_0321_1000.hdr"

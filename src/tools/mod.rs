@@ -4,6 +4,7 @@
 use std::process::ExitCode;
 
 pub mod checkbsdf;
+pub mod dametrics;
 pub mod dctimestep;
 pub mod genbsdf;
 pub mod gendaylit;
@@ -33,6 +34,7 @@ pub type Run = fn(Vec<String>) -> anyhow::Result<ExitCode>;
 pub fn registry() -> &'static [(&'static str, Run)] {
     &[
         ("checkBSDF", checkbsdf::run),
+        ("dametrics", dametrics::run),
         ("dctimestep", dctimestep::run),
         ("genBSDF", genbsdf::run),
         ("gendaylit", gendaylit::run),
