@@ -9,7 +9,7 @@
 #
 # Usage: examples/three-phase/matrices.sh [OUTDIR]      (default: examples/three-phase/out/matrices)
 # Settings (environment): V_OPTS (default "-ab 6 -ad 6250 -lw 2e-5", traced REPLICAS times per sensor: 50 000
-# ambient samples in all), D_OPTS ("-ab 2 -ad 1000 -lw 1e-4"), D_C (rays per Klems patch, 1000) — the parameters of
+# first-bounce samples in all, where -ad 50000 -lw 2e-5 discards about half of its 50 000 by the weight limit), D_OPTS ("-ab 2 -ad 1000 -lw 1e-4"), D_C (rays per Klems patch, 1000) — the parameters of
 # the matrices in matrices/; REPLICAS (8; 0: none) independent replicas per record written beside each matrix
 # (X.err: standard errors, X.rep: replicas, for dctimestep -Rv/-Rd); FENESTRA_BIN=dir to use already-built binaries
 # instead of building them.
