@@ -6,6 +6,7 @@ use std::process::ExitCode;
 pub mod checkbsdf;
 pub mod dametrics;
 pub mod dctimestep;
+pub mod errplot;
 pub mod genbsdf;
 pub mod gendaylit;
 pub mod gendaymtx;
@@ -36,6 +37,7 @@ pub fn registry() -> &'static [(&'static str, Run)] {
         ("checkBSDF", checkbsdf::run),
         ("dametrics", dametrics::run),
         ("dctimestep", dctimestep::run),
+        ("errplot", errplot::run),
         ("genBSDF", genbsdf::run),
         ("gendaylit", gendaylit::run),
         ("gendaymtx", gendaymtx::run),
