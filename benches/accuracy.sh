@@ -11,7 +11,7 @@
 # the reference's own standard error (from its replicas: dctimestep -Rv -Rd -Eo) and the three-phase method's own
 # limit (the converged three-phase result against a direct rtrace of the same room with both windows as BSDF
 # materials, averaged over seeds).
-# Writes OUT/curves.tsv (every run), OUT/{overcast,clear,udi,da300}.svg (errplot), and the generated part of
+# Writes OUT/curves.tsv (every run), OUT/{overcast,clear,udi,da300,method}.svg, OUT/method.tsv (errplot), and the generated part of
 # docs/accuracy.md (between its markers) when OUT is docs/accuracy.
 # Usage: benches/accuracy.sh [--quick] [--out DIR]   (FENESTRA_BIN=dir of built binaries, default target/testopt;
 # --quick: two settings per knob, one seed, a cheap reference: checks that the pipeline works, not the numbers)
@@ -39,10 +39,11 @@ cp tests/fixtures/rtrace_threephase_bsdf/skyfunc_glow.rad "$work/"
 cd "$work"
 
 if [ $quick = 1 ]; then
-  D_SET="25 100"; AD_SET="256 1024"; AB_SET="1 2"; SEEDS="1"
+  D_SET="25 100"; AD_SET="256 1024"; AB_SET="1 2"; SEEDS="1"; MF_SET="1 2"; MF_C=50
   VREF="-ab 6 -ad 1024 -lw 2e-5 -E -Er 2"; DREF=100; DIRECT_SEEDS="1 2"
 else
   D_SET="25 50 100 200 400 800"; AD_SET="256 512 1024 2048 4096 8192"; AB_SET="1 2 3 4"; SEEDS="1 2 3"
+  MF_SET="1 2 4"; MF_C=1000
   VREF="-ab 6 -ad 6250 -lw 2e-5 -E -Er 32"; DREF=4000; DIRECT_SEEDS=$(seq 1 16)
 fi
 D_OPTS="-ab 2 -ad 1000 -lw 1e-4"
@@ -63,14 +64,15 @@ V() {
   rtcontrib -n 2 -fo -I+ $@ -seed "$seed" -faf -f klems_full.cal -bn Nkbins -o "V_${name}_%s.vmx" \
     -b kbinS -m SouthGroup -b kbinW -m WestGroup vmx.oct < sensors.pts
 }
-# D NAME SEED C [OPTS..]: D of both groups (D_NAME_South.dmx, D_NAME_West.dmx), C rays per Klems patch
+# D NAME SEED C [OPTS..]: D of both groups (D_NAME_South.dmx, D_NAME_West.dmx), C rays per Klems patch, sky
+# subdivision MF (environment, default 1)
 D() {
   local name=$1 seed=$2 c=$3; shift 3
   genklemsamp -ff -s "$seed" -c "$c" -vd 0 -1 0 -vu 0 0 1 window_out.rad |
-    rtcontrib -n 2 -fo -c "$c" -ff $D_OPTS "$@" -seed "$seed" -e MF:1 -f reinhart.cal -b rbin -bn Nrbins \
+    rtcontrib -n 2 -fo -c "$c" -ff $D_OPTS "$@" -seed "$seed" -e "MF:${MF:-1}" -f reinhart.cal -b rbin -bn Nrbins \
       -o "D_${name}_South.dmx" -m skyglow dmx.oct
   genklemsamp -ff -s "$seed" -c "$c" -vd -1 0 0 -vu 0 0 1 window_west_out.rad |
-    rtcontrib -n 2 -fo -c "$c" -ff $D_OPTS "$@" -seed "$seed" -e MF:1 -f reinhart.cal -b rbin -bn Nrbins \
+    rtcontrib -n 2 -fo -c "$c" -ff $D_OPTS "$@" -seed "$seed" -e "MF:${MF:-1}" -f reinhart.cal -b rbin -bn Nrbins \
       -o "D_${name}_West.dmx" -m skyglow dmx.oct
 }
 # LUX VNAME DNAME SKY: lux per sensor and time step (both groups summed), data only
@@ -155,6 +157,27 @@ for b in $AB_SET; do
   row V-ab "$b" 1 "$(elapsed $t0 $t1)" t ref
 done
 
+# the method: sky subdivision MF 1, 2, 4 (D at -c MF_C, V the reference) against the direct rtrace
+printf "# benches/accuracy.sh%s: three-phase against direct rtrace by sky subdivision\n# MF\tD_seconds\tovercast_rms_pct\tclear_rms_pct\n" \
+  "$([ $quick = 1 ] && echo " --quick")" > "$out/method.tsv"
+for mf in $MF_SET; do
+  echo "== sky subdivision MF $mf (D -c $MF_C) against direct rtrace" >&2
+  for s in overcast clear; do genskyvec -m "$mf" < $s.rad > ${s}_mf$mf.skv; done
+  t0=$(now); MF=$mf D mf$mf 1 "$MF_C"; t1=$(now)
+  LUX ref mf$mf overcast_mf$mf.skv > o.dat
+  LUX ref mf$mf clear_mf$mf.skv > c.dat
+  printf "%s\t%s\t%s\t%s\n" "$mf" "$(elapsed $t0 $t1)" "$(RMS o.dat direct_overcast.dat)" "$(RMS c.dat direct_clear.dat)" \
+    >> "$out/method.tsv"
+done
+# x: sky patches (Reinhart: 144 MF² + 2); D's time does not change with MF (the same rays)
+awk -F'\t' '!/^#/ { printf "overcast sky\t%d\t%s\n", 144 * $1 * $1 + 2, $3 }' "$out/method.tsv" > chart_method.tsv
+awk -F'\t' '!/^#/ { printf "clear sky with sun\t%d\t%s\n", 144 * $1 * $1 + 2, $4 }' "$out/method.tsv" >> chart_method.tsv
+errplot -t "The method: three-phase against direct rtrace, sky MF $(echo $MF_SET | tr ' ' /)" \
+  -x "sky patches (Reinhart MF $(echo $MF_SET | tr ' ' /); D -c $MF_C, the same time for each)" \
+  -y "rms difference from direct rtrace (%)" \
+  -H "$(cat direct_overcast.se)" "direct rtrace's own standard error, overcast" \
+  -H "$(cat direct_clear.se)" "direct rtrace's own standard error, clear" -o "$out/method.svg" chart_method.tsv
+
 # per setting: mean time, rms over seeds of each error
 awk -F'\t' '!/^#/ { k = $1 "\t" $2; if (!(k in n)) order[++m] = k; n[k]++; t[k] += $4
     o[k] += $5 * $5; c[k] += $6 * $6; d[k] += $7 * $7; u[k] += $8 * $8 }
@@ -220,6 +243,14 @@ errplot -t "Annual DA300 (8-18 h) at 45 sensors" -x "wall time of the step (s), 
   echo "![UDI](accuracy/udi.svg)"
   echo
   echo "![DA300](accuracy/da300.svg)"
+  echo
+  echo "The method itself, by sky subdivision (Reinhart MF; D at \`-c $MF_C\`, V the reference), against the direct rtrace:"
+  echo
+  echo "| MF | D wall s | overcast rms % | clear rms % |"
+  echo "|---|---|---|---|"
+  awk -F'\t' '!/^#/ { printf "| %s | %.2f | %.2f | %.2f |\n", $1, $2, $3, $4 }' "$out/method.tsv"
+  echo
+  echo "![method](accuracy/method.svg)"
 } > "$out/generated.md"
 if [ "$out" = "$top/docs/accuracy" ]; then
   doc=$top/docs/accuracy.md

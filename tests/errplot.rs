@@ -95,10 +95,18 @@ fn accuracy_bench_runs_quick() {
             "{r:?}"
         );
     }
-    for f in ["overcast.svg", "clear.svg", "udi.svg", "da300.svg"] {
+    for f in ["overcast.svg", "clear.svg", "udi.svg", "da300.svg", "method.svg"] {
         let svg = std::fs::read_to_string(dir.join(f)).unwrap();
-        assert!(svg.contains("wall time of the step (s)"), "{f}");
+        assert!(svg.contains("wall time of") || svg.contains("sky patches"), "{f}");
     }
+    // the method table: MF 1 and 2 against the direct rtrace
+    let method = std::fs::read_to_string(dir.join("method.tsv")).unwrap();
+    let mfs: Vec<&str> = method
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| l.split('\t').next().unwrap())
+        .collect();
+    assert_eq!(mfs, ["1", "2"], "{method}");
     let gen = std::fs::read_to_string(dir.join("generated.md")).unwrap();
     assert!(
         gen.contains("| V-ab | 2 |") && gen.contains("direct rtrace"),
