@@ -79,6 +79,7 @@ fn in_process(dir: &std::path::Path, count: usize, stream: bool, name: &str) {
         values,
         errors: Vec::new(),
         replicas: Vec::new(),
+        budget: Default::default(),
         format: Format::Ascii,
     };
     let pool = fenestra_cli::threads::pool(2).unwrap();

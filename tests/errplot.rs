@@ -95,9 +95,18 @@ fn accuracy_bench_runs_quick() {
             "{r:?}"
         );
     }
-    for f in ["overcast.svg", "clear.svg", "udi.svg", "da300.svg", "method.svg"] {
+    for f in [
+        "overcast.svg",
+        "clear.svg",
+        "udi.svg",
+        "da300.svg",
+        "method.svg",
+    ] {
         let svg = std::fs::read_to_string(dir.join(f)).unwrap();
-        assert!(svg.contains("wall time of") || svg.contains("sky patches"), "{f}");
+        assert!(
+            svg.contains("wall time of") || svg.contains("sky patches"),
+            "{f}"
+        );
     }
     // the method table: MF 1 and 2 against the direct rtrace
     let method = std::fs::read_to_string(dir.join("method.tsv")).unwrap();

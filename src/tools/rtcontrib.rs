@@ -14,7 +14,7 @@ use fenestra_trace::{TraceOptions, Tracer};
 /// Most bins one modifier may have (2^24: 400 MiB of sums per thread).
 const MAX_BINS: usize = 1 << 24;
 
-const USAGE: &str = "[-n N][-V][-I|-i][-c N][-f{a,f,d}{a,f,d,c}][-fo|-r][-x X -y Y][-o spec][-E][-Eo spec][-Eb N][-Er K][-p a=1,..][-e expr][-f file.cal][-b binexpr][-bn N] {-m mod | -M file} .. [-ab N -ad N -lw W -lr N -ds V -dj V -st V -ss V -bv -seed N ..] scene.{oct,rad} ..";
+const USAGE: &str = "[-n N][-v][-V][-I|-i][-c N][-f{a,f,d}{a,f,d,c}][-fo|-r][-x X -y Y][-o spec][-E][-Eo spec][-Eb N][-Er K][-p a=1,..][-e expr][-f file.cal][-b binexpr][-bn N] {-m mod | -M file} .. [-ab N -ad N -lw W -lr N -ds V -dj V -st V -ss V -bv -seed N ..] scene.{oct,rad} ..";
 
 struct ModArg {
     name: String,
@@ -79,6 +79,8 @@ pub fn run_with(
     let (mut irr, mut value, mut header, mut warnings, mut overwrite, mut errors) =
         (false, false, true, true, false, false);
     let mut recover = false;
+    let mut verbose = false;
+    let started = std::time::Instant::now();
     let mut irr_hit = false;
     let mut limit_dist = false;
     let mut count = 1usize;
@@ -177,6 +179,10 @@ pub fn run_with(
                 format!("-w{}\t\t\t\t# warning messages", pm(warnings)),
                 format!("-I{}\t\t\t\t# irradiance (point and normal input)", pm(irr)),
                 format!("-E{}\t\t\t\t# standard errors (fenestra)", pm(errors)),
+                format!(
+                    "-v{}\t\t\t\t# report effects, rays and the totals' standard errors (fenestra)",
+                    pm(verbose)
+                ),
                 format!("-Eb {batches:<8}\t\t# replicas per record for -E with -c 1 (fenestra)"),
                 format!(
                     "-Er {replicas:<8}\t\t# replica rows written per record, 0: none (fenestra)"
@@ -206,7 +212,9 @@ pub fn run_with(
             }
             return Ok(ExitCode::SUCCESS);
         }
-        if let Some(v) = toggle(a, "V", value) {
+        if let Some(v) = toggle(a, "v", verbose) {
+            verbose = v;
+        } else if let Some(v) = toggle(a, "V", value) {
             value = v;
         } else if let Some(v) = toggle(a, "I", irr) {
             irr = v;
@@ -653,6 +661,7 @@ pub fn run_with(
         errors: err_streams,
         replicas: rep_streams,
         format: fout,
+        budget: Default::default(),
     };
 
     let engine = Engine::new(&tracer, &bins, scene.prims.len(), &tracked, opts);
@@ -698,9 +707,17 @@ pub fn run_with(
             fenestra_cli::warn(format!("bad bin number ({b} ignored)"));
         }
     }
+    let budget = std::mem::take(&mut out.budget);
     out.finish()?;
     for msg in input.take_warnings() {
         fenestra_cli::warn(msg);
+    }
+    if verbose {
+        let names: Vec<String> = mods.iter().map(|m| m.name.clone()).collect();
+        let secs = started.elapsed().as_secs_f64();
+        for l in budget.lines(&names, tracer.ray_counts(), secs, tracer.effects()) {
+            eprintln!("{}: {l}", fenestra_cli::prog());
+        }
     }
     if let Some(e) = expect {
         if total_rays < e {

@@ -394,10 +394,15 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         ));
     }
     if verbose {
+        let c = tracer.ray_counts();
         eprintln!(
-            "{}: {} rays traced for {k0} input records",
+            "{}: {} rays traced for {k0} input records: {} primary, {} shadow, {} indirect (ambient samples and below), {} specular/transmitted",
             fenestra_cli::prog(),
-            tracer.rays_traced()
+            tracer.rays_traced(),
+            c.primary,
+            c.shadow,
+            c.indirect,
+            c.specular
         );
     }
     if expect > 0 && k0 < expect {

@@ -131,7 +131,14 @@ pub struct Record {
     /// With `-Er K`: K replica estimates, `3 × total bins` each, one after the other;
     /// their mean is the value.
     pub replicas: Option<Vec<f64>>,
+    /// With `-E`: per modifier, the standard error of the record's total over its bins in
+    /// luminance units ([`Y`] weights; from the rays' own totals, so every covariance
+    /// between bins is included).
+    pub total_se: Option<Vec<f64>>,
 }
+
+/// Radiance's luminance weights of R, G, B (the `-v` budget's totals).
+pub const Y: [f64; 3] = [0.265, 0.670, 0.065];
 
 /// The contribution tracer.
 pub struct Engine<'a> {
@@ -141,6 +148,8 @@ pub struct Engine<'a> {
     our_mod: Vec<u32>,
     offsets: Vec<usize>,
     nbins: Vec<usize>,
+    /// Modifier of every bin slot (modifiers in order).
+    slot_mod: Vec<u32>,
     total: usize,
     opts: RunOptions,
     bad: Mutex<BTreeSet<(usize, i64)>>,
@@ -153,6 +162,9 @@ struct Acc {
     sumsq: Vec<f64>,
     /// Per-replica sums (`replicas × 3 × total bins`), with `-Er`.
     rep: Vec<f64>,
+    /// Per modifier: sums of the rays' luminance totals and of their squares, with errors.
+    tot: Vec<f64>,
+    totsq: Vec<f64>,
     n: usize,
 }
 
@@ -193,6 +205,11 @@ impl<'a> Engine<'a> {
             our_mod,
             offsets,
             nbins: mods.iter().map(|m| m.nbins).collect(),
+            slot_mod: mods
+                .iter()
+                .enumerate()
+                .flat_map(|(k, m)| std::iter::repeat_n(k as u32, m.nbins))
+                .collect(),
             total,
             opts,
             bad: Mutex::new(BTreeSet::new()),
@@ -203,6 +220,16 @@ impl<'a> Engine<'a> {
     /// Index of modifier `m`, bin `b` in a record's values (times 3 for RGB).
     pub fn slot(&self, m: usize, b: usize) -> usize {
         self.offsets[m] + b
+    }
+
+    /// Per modifier: the total of a record's values over its bins, in luminance units.
+    pub fn modifier_totals(&self, rec: &Record) -> Vec<f64> {
+        let mut t = vec![0.0; self.nbins.len()];
+        for (k, &m) in self.slot_mod.iter().enumerate() {
+            let v = &rec.sums[k * 3..k * 3 + 3];
+            t[m as usize] += (Y[0] * v[0] + Y[1] * v[1] + Y[2] * v[2]) * rec.scale;
+        }
+        t
     }
 
     /// Bad bin numbers met so far (modifier, bin), for the warning; taken.
@@ -331,7 +358,17 @@ impl<'a> Engine<'a> {
                 scratch.tmp = vec![0.0; n3];
             }
             a.rep = vec![0.0; n3 * self.opts.replicas];
+            a.tot = vec![0.0; self.nbins.len()];
+            a.totsq = vec![0.0; self.nbins.len()];
         }
+        let mut ray_tot = vec![
+            0.0;
+            if self.opts.errors {
+                self.nbins.len()
+            } else {
+                0
+            }
+        ];
         let nrep = self.opts.replicas;
         for (j, (idx, r)) in rays.enumerate() {
             a.n += 1;
@@ -349,6 +386,15 @@ impl<'a> Engine<'a> {
                             rep[c] += tmp[c];
                         }
                     }
+                }
+                for &s in &touched {
+                    let y = Y[0] * tmp[s] + Y[1] * tmp[s + 1] + Y[2] * tmp[s + 2];
+                    ray_tot[self.slot_mod[s / 3] as usize] += y;
+                }
+                for (m, t) in ray_tot.iter_mut().enumerate() {
+                    a.tot[m] += *t;
+                    a.totsq[m] += *t * *t;
+                    *t = 0.0;
                 }
                 for &s in &touched {
                     let sums = a.sum[s..s + 3].iter_mut().zip(&mut a.sumsq[s..s + 3]);
@@ -373,27 +419,31 @@ impl<'a> Engine<'a> {
 
     fn finish(&self, a: Acc, sum_only: bool) -> Record {
         let n = a.n.max(1) as f64;
-        let errors = if self.opts.errors {
-            Some(
-                a.sum
-                    .iter()
-                    .zip(&a.sumsq)
-                    .map(|(s, q)| {
-                        if a.n < 2 {
-                            return 0.0;
-                        }
-                        let var = ((q - s * s / n) / (n - 1.0)).max(0.0);
-                        if sum_only {
-                            (n * var).sqrt()
-                        } else {
-                            (var / n).sqrt()
-                        }
-                    })
-                    .collect(),
-            )
-        } else {
-            None
+        let se = |s: f64, q: f64| {
+            if a.n < 2 {
+                return 0.0;
+            }
+            let var = ((q - s * s / n) / (n - 1.0)).max(0.0);
+            if sum_only {
+                (n * var).sqrt()
+            } else {
+                (var / n).sqrt()
+            }
         };
+        let errors = self.opts.errors.then(|| {
+            a.sum
+                .iter()
+                .zip(&a.sumsq)
+                .map(|(s, q)| se(*s, *q))
+                .collect()
+        });
+        let total_se = self.opts.errors.then(|| {
+            a.tot
+                .iter()
+                .zip(&a.totsq)
+                .map(|(s, q)| se(*s, *q))
+                .collect()
+        });
         // replica k's estimate is K/n times its group's sum, so that their mean is the value
         let replicas = (self.opts.replicas > 0 && !sum_only).then(|| {
             let f = self.opts.replicas as f64 / n;
@@ -404,6 +454,7 @@ impl<'a> Engine<'a> {
             scale: if sum_only { 1.0 } else { 1.0 / n },
             errors,
             replicas,
+            total_se,
         }
     }
 
@@ -489,6 +540,22 @@ impl<'a> Engine<'a> {
             } else {
                 Vec::new()
             },
+            tot: vec![
+                0.0;
+                if self.opts.errors {
+                    self.nbins.len()
+                } else {
+                    0
+                }
+            ],
+            totsq: vec![
+                0.0;
+                if self.opts.errors {
+                    self.nbins.len()
+                } else {
+                    0
+                }
+            ],
             ..Default::default()
         };
         for block in idx.chunks(CHUNK * 64) {
@@ -509,6 +576,12 @@ impl<'a> Engine<'a> {
                     *t += s;
                 }
                 for (t, s) in total.sumsq.iter_mut().zip(&p.sumsq) {
+                    *t += s;
+                }
+                for (t, s) in total.tot.iter_mut().zip(&p.tot) {
+                    *t += s;
+                }
+                for (t, s) in total.totsq.iter_mut().zip(&p.totsq) {
                     *t += s;
                 }
             }

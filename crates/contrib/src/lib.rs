@@ -3,6 +3,7 @@
 //! and the Klems window sampler behind genklemsamp.
 
 pub mod bins;
+pub mod budget;
 pub mod engine;
 pub mod klemsamp;
 pub mod native;

@@ -23,11 +23,14 @@ pub struct Outputs {
     pub replicas: Vec<Stream>,
     /// Data format of every stream.
     pub format: Format,
+    /// What the written records add up to (for `-v`).
+    pub budget: crate::budget::Budget,
 }
 
 impl Outputs {
     /// Writes one record to every stream.
     pub fn write(&mut self, engine: &Engine, rec: &Record) -> Result<()> {
+        self.budget.add(engine, rec);
         for s in self.values.iter_mut() {
             s.write_record(self.format, rec.scale, |m, b| {
                 let k = engine.slot(m, b) * 3;

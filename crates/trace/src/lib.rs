@@ -28,4 +28,4 @@ pub mod waves;
 
 pub use glam::DVec3;
 pub use options::TraceOptions;
-pub use tracer::{Contribution, DirectState, Effects, SourceLight, Tracer};
+pub use tracer::{Contribution, DirectState, Effects, RayCounts, SourceLight, Tracer};

@@ -188,8 +188,9 @@ impl<T> std::ops::Index<&usize> for Dense<T> {
 
 struct Ctx<'a> {
     rng: Rng,
-    /// Rays traced in this context (added to the tracer's total once, at the end).
-    rays: u64,
+    /// Rays traced in this context by kind ([`RayCounts`] order: primary, shadow, indirect,
+    /// specular), added to the tracer's totals once, at the end.
+    rays: [u64; 4],
     tracked: &'a [bool],
     sink: Option<&'a mut dyn FnMut(Contribution)>,
     /// Source-thresholding state (only when thresholding applies).
@@ -233,6 +234,20 @@ struct Distant {
     glow: bool,
 }
 
+/// Rays traced, by kind (a tool's `-v` budget line).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct RayCounts {
+    /// First rays of records (rtcontrib `-I` irradiance records start with their ambient
+    /// samples instead, counted as indirect).
+    pub primary: u64,
+    /// Shadow rays toward light sources (with their continuations through glass).
+    pub shadow: u64,
+    /// Ambient samples and every ray descending from one.
+    pub indirect: u64,
+    /// Specular reflections and transmissions not below an ambient sample.
+    pub specular: u64,
+}
+
 /// What the integrator switched on, and why (printed by `-v`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Effects {
@@ -265,7 +280,7 @@ pub struct Tracer {
     opts: TraceOptions,
     effects: Effects,
     warnings: Vec<String>,
-    rays: std::sync::atomic::AtomicU64,
+    rays: [std::sync::atomic::AtomicU64; 4],
     /// With source thresholding: every source's initial obstructor cache.
     obs: Option<Vec<Option<ObsCache>>>,
     /// Per BVH shape: a reliable shadow-ray blocker (opaque material, never clipped).
@@ -399,11 +414,34 @@ impl Tracer {
 
     /// Number of rays traced so far (all kinds).
     pub fn rays_traced(&self) -> u64 {
-        self.rays.load(std::sync::atomic::Ordering::Relaxed)
+        let c = self.ray_counts();
+        c.primary + c.shadow + c.indirect + c.specular
+    }
+
+    /// Rays traced so far, by kind.
+    pub fn ray_counts(&self) -> RayCounts {
+        let get = |k: usize| self.rays[k].load(std::sync::atomic::Ordering::Relaxed);
+        RayCounts {
+            primary: get(0),
+            shadow: get(1),
+            indirect: get(2),
+            specular: get(3),
+        }
     }
 
     fn trace(&self, r: &Ray, cx: &mut Ctx) -> DVec3 {
-        cx.rays += 1;
+        // kind: a shadow ray (also where it passes through glass), the first ray of a
+        // record, a ray descending from an ambient sample, or a specular/transmitted one
+        let kind = if r.flags & SHADOW != 0 {
+            1
+        } else if r.depth == 0 {
+            0
+        } else if r.flags & AMBIENT != 0 {
+            2
+        } else {
+            3
+        };
+        cx.rays[kind] += 1;
         let tmin = Self::tmin(r.org);
         if self.effects.occlusion_shadows && r.flags & SHADOW != 0 {
             if let Some(s) = r.src {

@@ -256,7 +256,7 @@ mod tests {
         let run = |seed: u64, extra: usize| {
             let mut cx = Ctx {
                 rng: Rng::for_ray(seed, 0),
-                rays: 0,
+                rays: [0; 4],
                 tracked: &[],
                 sink: None,
                 ds: None,

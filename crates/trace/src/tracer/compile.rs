@@ -392,7 +392,7 @@ impl Tracer {
                 notes,
             },
             warnings,
-            rays: std::sync::atomic::AtomicU64::new(0),
+            rays: Default::default(),
             obs: None,
             blocker,
             irr_pass,

@@ -161,7 +161,7 @@ impl Tracer {
     ) -> Ctx<'a> {
         Ctx {
             rng: Rng::for_ray(self.opts.seed, ray_index),
-            rays: 0,
+            rays: [0; 4],
             tracked,
             sink,
             ds,
@@ -183,8 +183,9 @@ impl Tracer {
     }
 
     pub(super) fn count(&self, cx: &Ctx) {
-        self.rays
-            .fetch_add(cx.rays, std::sync::atomic::Ordering::Relaxed);
+        for (total, n) in self.rays.iter().zip(cx.rays) {
+            total.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
+        }
     }
 
     /// Where Radiance's rtrace `-I` evaluates the irradiance for an input `point` and

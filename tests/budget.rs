@@ -1,0 +1,99 @@
+//! rtcontrib -v: the run's budget (effects, rays by kind, each modifier's total with its
+//! standard error), and that standard error checked against the spread of independent runs.
+
+mod common;
+
+/// D of the bundled office's south window at `-c 20` with `seed`; stderr of the run.
+fn d_run(dir: &std::path::Path, seed: u64, extra: &[&str]) -> String {
+    let ex =
+        std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/three-phase/scene");
+    let s = seed.to_string();
+    let mut g = common::fenestra("genklemsamp");
+    g.args([
+        "-ff", "-c", "20", "-s", &s, "-vd", "0", "-1", "0", "-vu", "0", "0", "1",
+    ])
+    .arg(ex.join("window_out.rad"));
+    let rays = common::run_ok(&mut g);
+    let mut d = common::fenestra("rtcontrib");
+    d.args([
+        "-v", "-fo", "-c", "20", "-ffa", "-ab", "1", "-ad", "64", "-lw", "1e-3", "-seed", &s,
+    ])
+    .args(extra)
+    .args([
+        "-o",
+        "D.dmx",
+        "-e",
+        "MF:1",
+        "-f",
+        "reinhart.cal",
+        "-b",
+        "rbin",
+        "-bn",
+        "Nrbins",
+        "-m",
+        "skyglow",
+    ])
+    .args(["materials.rad", "room.rad", "exterior.rad", "sky_dmx.rad"].map(|f| ex.join(f)))
+    .current_dir(dir);
+    let out = common::run_stdin(d, &rays);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// (total, relative standard error %) from the modifier line of `-v`.
+fn total_line(err: &str) -> (f64, Option<f64>) {
+    let l = err
+        .lines()
+        .find(|l| l.contains("modifier skyglow: total of every value"))
+        .unwrap_or_else(|| panic!("{err}"));
+    let w: Vec<&str> = l.split_whitespace().collect();
+    let k = w.iter().position(|x| *x == "value").unwrap();
+    let total = w[k + 1].parse().unwrap();
+    let se = l
+        .split("standard error ")
+        .nth(1)
+        .and_then(|r| r.split('%').next())
+        .and_then(|x| x.trim().parse().ok());
+    (total, se)
+}
+
+#[test]
+fn budget_lines_and_the_total_s_error_against_independent_runs() {
+    let dir = common::scratch("budget");
+    let err = d_run(&dir, 1, &[]);
+    assert!(err.contains("effect: ambient: on (-ab 1)"), "{err}");
+    assert!(
+        err.contains("145 records in") && err.contains("2900 primary"),
+        "{err}"
+    );
+    assert!(
+        err.contains("standard error not computed (give -E)"),
+        "{err}"
+    );
+    // 30 seeds with -E: the spread of the total against the predicted standard error. The
+    // observed sd of 30 runs is uncertain by 1/√58 = 13%; the prediction (2 900 rays' own
+    // totals per run) by about 3%: ±35% is 2.6 of their combined 13.5%.
+    let runs: Vec<(f64, f64)> = (0..30)
+        .map(|s| {
+            let (t, se) = total_line(&d_run(&dir, 100 + s, &["-E"]));
+            (t, t * se.expect("a standard error with -E") / 100.0)
+        })
+        .collect();
+    let n = runs.len() as f64;
+    let mean = runs.iter().map(|r| r.0).sum::<f64>() / n;
+    let sd = (runs.iter().map(|r| (r.0 - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    let pred = (runs.iter().map(|r| r.1 * r.1).sum::<f64>() / n).sqrt();
+    eprintln!(
+        "total {mean:.4}: observed sd {sd:.5}, predicted {pred:.5}, ratio {:.3}",
+        pred / sd
+    );
+    assert!(
+        (pred / sd - 1.0).abs() <= 0.35,
+        "predicted {pred} observed {sd}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
