@@ -343,6 +343,11 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             }
         }
     }
+    // -v: the engine's budget at the end too (effects, rays by kind, totals' errors)
+    let mut rc = rc;
+    if s.verbose {
+        rc.insert(1, "-v".to_string());
+    }
     let scene = super::rtcontrib::Preloaded {
         scene: load_scene(system, receivers_spec)?,
         header: vec![fenestra_cli::command_line(&args)],
