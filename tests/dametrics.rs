@@ -91,6 +91,23 @@ fn metrics_by_hand_with_occupancy_and_bands() {
         "{room}"
     );
     assert!(room.ends_with("over 2 sensors, 3 occupied hours"), "{room}");
+    // the floor-plan map: a cell per sensor and panel, values printed
+    write(&dir, "p.pts", "0.5 0.5 0.8 0 0 1\n1.5 0.5 0.8 0 0 1\n");
+    let out = run(
+        &dir,
+        &["-w", "t.wea", "-p", "p.pts", "-m", "map.svg", "ill.dat"],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let svg = std::fs::read_to_string(dir.join("map.svg")).unwrap();
+    assert_eq!(svg.matches("stroke=\"white\"").count(), 4, "{svg}");
+    assert!(
+        svg.contains(">33<") && svg.contains(">67<") && svg.contains("DA300 (%)"),
+        "{svg}"
+    );
     // every column occupied without -w; -t, -u, -z change the thresholds
     let out = run(&dir, &["-t", "250", "-u", "60", "5000", "ill.dat"]);
     let text = String::from_utf8_lossy(&out.stdout);
@@ -124,6 +141,7 @@ fn bad_input_is_refused_with_a_message() {
         (&["-o", "8", "18", "ill.dat"], "-o needs -w"),
         (&["-u", "2000", "100", "ill.dat"], "below the second"),
         (&["-z", "0", "ill.dat"], "positive"),
+        (&["-m", "x.svg", "ill.dat"], "-m needs -p"),
         (&["-p", "p.pts", "ill.dat"], "p.pts, line 2"),
         (&["missing.dat"], "missing.dat"),
         (&[], "one illuminance matrix expected"),

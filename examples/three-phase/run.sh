@@ -11,7 +11,8 @@
 #
 #   phases I, II   matrices.sh: V (room → window, Klems) with rtcontrib -I, D (window → sky, Reinhart MF 1) with
 #                  genklemsamp | rtcontrib, per window group (scene/); matrices/ holds the same at these settings
-#   picture        21 March 10:00: vwrays | rtcontrib -ffc (V per pixel), dctimestep per group, pcomb
+#   picture        21 March 10:00: vwrays | rtcontrib -ffc (V per pixel), dctimestep per group, pcomb; PNG and false
+#                  colour by hdr2png (PICTURE_RES=px, default 200)
 # Usage: examples/three-phase/run.sh   (OUT=dir to choose where results go; FENESTRA_BIN=dir to use
 # already-built binaries instead of building them; MATRICES=bundled to use the bundled V and D instead of
 # computing them first with fenestra's genklemsamp/rtcontrib through matrices.sh)
@@ -53,15 +54,16 @@ rmtxop -ff "!dctimestep $es $m/V_SouthGroup.vmx matrices/blinds_kf.xml $m/D_Sout
   + "!dctimestep $ew $m/V_WestGroup.vmx matrices/clear_glass_kf.xml $m/D_WestGroup.dmx $out/sky.smx" |
   rmtxop -fa -c 47.435 119.93 11.635 - > "$out/ill.dat"
 
-echo "== one moment as a picture: V per pixel (vwrays | rtcontrib -ffc, both groups), dctimestep per group, pcomb" >&2
+echo "== one moment as a picture (${PICTURE_RES:=200} px): V per pixel (vwrays | rtcontrib -ffc, both groups), dctimestep per group, pcomb" >&2
+pic_start=$(date +%s.%N)
 gensky 3 21 10 +s -a 37.71 -o 122.21 -m 120 | genskyvec -m 1 > "$out/sky_0321_1000.skv"
 mkdir -p "$out/vimg"
 (
   cd scene
   oconv materials.rad room.rad window_vmx.rad window_west_vmx.rad > "$out/vimg/vmx.oct"
   # shellcheck disable=SC2046  # vwrays -d prints the -x -y options rtcontrib needs
-  vwrays -ff -vf view.vf -x 64 -y 64 |
-    rtcontrib -n "$nproc" -fo $(vwrays -vf view.vf -x 64 -y 64 -d) -ffc -ab 2 -ad 256 -lw 1e-3 \
+  vwrays -ff -vf view.vf -x "$PICTURE_RES" -y "$PICTURE_RES" |
+    rtcontrib -n "$nproc" -fo $(vwrays -vf view.vf -x "$PICTURE_RES" -y "$PICTURE_RES" -d) -ffc -ab 2 -ad 1024 -lw 1e-4 \
       -o "$out/vimg/%s_%03d.hdr" -f klems_full.cal -bn Nkbins -b kbinS -m SouthGroup -b kbinW -m WestGroup \
       "$out/vimg/vmx.oct"
 )
@@ -69,11 +71,14 @@ pcomb "!dctimestep $out/vimg/SouthGroup_%03d.hdr matrices/blinds_kf.xml $m/D_Sou
   "!dctimestep $out/vimg/WestGroup_%03d.hdr matrices/clear_glass_kf.xml $m/D_WestGroup.dmx $out/sky_0321_1000.skv" \
   > "$out/view_0321_1000.hdr"
 end=$(date +%s.%N)
+pic_secs=$(awk -v a="$pic_start" -v b="$end" 'BEGIN { printf "%.1f", b - a }')
 
 echo "== annual metrics per sensor (working hours 8-18 h local standard time)"
-dametrics -w weather/sf_year.wea -o 8 18 -p scene/sensors.pts "${errs[@]}" "$out/ill.dat" | tee "$out/metrics.txt"
+dametrics -w weather/sf_year.wea -o 8 18 -p scene/sensors.pts -m "$out/metrics_map.svg" "${errs[@]}" "$out/ill.dat" |
+  tee "$out/metrics.txt"
+echo "floor-plan map of DA300 and UDI per sensor: $out/metrics_map.svg"
 hdr2png -o "$out/view_0321_1000.png" "$out/view_0321_1000.hdr" 2> /dev/null
 hdr2png -f auto -o "$out/view_0321_1000_falsecolor.png" "$out/view_0321_1000.hdr" 2> "$out/falsecolor_scale.txt"
-echo "picture of 21 March 10:00 (radiance through both windows, as seen from the back of the room): $out/view_0321_1000.hdr"
+echo "picture of 21 March 10:00 (radiance through both windows, as seen from the back of the room; $PICTURE_RES px, -ab 2 -ad 1024, $pic_secs s): $out/view_0321_1000.hdr"
 echo "  the same as PNG: $out/view_0321_1000.png, in false colour: $out/view_0321_1000_falsecolor.png ($(cut -d: -f2- "$out/falsecolor_scale.txt"))"
 awk -v a="$start" -v b="$end" -v o="$out" 'BEGIN { printf "time for the pipeline (matrices, sky matrix, time steps, picture): %.2f s (results in %s)\n", b - a, o }'

@@ -19,7 +19,7 @@ fn spec() -> Spec {
         "dametrics",
         "Annual daylight metrics per sensor (DA, UDI, mean lux, sDA) from an illuminance matrix, with how far each can move within the results' standard errors",
     )
-    .usage("[-w weather.wea [-o start end]] [-t lux] [-u low high] [-s share] [-E err ..] [-z z] [-p sensors.pts] ill.dat")
+    .usage("[-w weather.wea [-o start end]] [-t lux] [-u low high] [-s share] [-E err ..] [-z z] [-p sensors.pts [-m map.svg]] ill.dat")
     .opt(Opt::new(
         "w",
         Kind::Word,
@@ -44,6 +44,11 @@ fn spec() -> Spec {
     ))
     .opt(Opt::new("z", Kind::Real, "half-width of the band in standard errors (default 2)"))
     .opt(Opt::new("p", Kind::Word, "sensor points (x y z dx dy dz per line), for the table's x y columns"))
+    .opt(Opt::new(
+        "m",
+        Kind::Word,
+        "write a floor-plan map (SVG) of DA and UDI per sensor here (needs -p)",
+    ))
 }
 
 /// A matrix as lux per sensor and hour: one component as is, three through [`LUX`].
@@ -126,6 +131,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let mut th = Thresholds::default();
     let (mut wea, mut hours, mut share) = (None::<String>, None::<(f64, f64)>, 0.5f64);
     let (mut errs, mut pts, mut pos) = (Vec::<String>::new(), None::<String>, Vec::new());
+    let mut map = None::<String>;
     for it in spec().parse(&args)? {
         match it {
             Item::Pos(p) => pos.push(p),
@@ -138,6 +144,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 "E" => errs.push(h.word().to_string()),
                 "z" => th.z = h.real(),
                 "p" => pts = Some(h.word().to_string()),
+                "m" => map = Some(h.word().to_string()),
                 _ => unreachable!("declared options only"),
             },
         }
@@ -198,6 +205,12 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             metrics::sensor(&lux[r.clone()], sd.as_ref().map(|s| &s[r]), &occupied, &th)
         })
         .collect();
+    if let Some(m) = &map {
+        let Some(xy) = &xy else {
+            bail!("-m needs -p: the map places each sensor at its x y");
+        };
+        write_map(m, xy, &sensors, &th)?;
+    }
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     write_table(&mut out, &sensors, xy.as_deref(), &th)?;
     let (sda, band) = metrics::spatial(&sensors, share);
@@ -246,6 +259,41 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     writeln!(out, " over {} sensors, {occ} occupied hours", sensors.len())?;
     out.flush()?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// The floor-plan map of DA and UDI per sensor (SVG, written whole then moved into place).
+fn write_map(
+    name: &str,
+    xy: &[(f64, f64)],
+    sensors: &[SensorMetrics],
+    th: &Thresholds,
+) -> Result<()> {
+    use fenestra_chart::plan::{Panel, Plan};
+    let pct = |f: &dyn Fn(&SensorMetrics) -> f64| sensors.iter().map(|s| 100.0 * f(s)).collect();
+    let plan = Plan {
+        title: format!(
+            "Annual daylight metrics per sensor ({} occupied hours)",
+            sensors.first().map_or(0, |s| s.hours)
+        ),
+        points: xy.to_vec(),
+        panels: vec![
+            Panel {
+                title: format!("DA{} (%)", th.da),
+                values: pct(&|s| s.da),
+            },
+            Panel {
+                title: format!("UDI {}-{} lux (%)", th.udi_low, th.udi_high),
+                values: pct(&|s| s.udi),
+            },
+        ],
+        range: (0.0, 100.0),
+        scale_label: "% of occupied hours".into(),
+    };
+    let svg = fenestra_chart::plan::to_svg(&plan)?;
+    let mut f = fenestra_cli::output::AtomicFile::create(name)?;
+    f.write_all(svg.as_bytes())?;
+    f.commit()?;
+    Ok(())
 }
 
 fn write_table(

@@ -3,6 +3,7 @@
 //! plot so that no text overlaps the data. Deterministic output, no plotting dependency.
 
 pub mod axis;
+pub mod plan;
 pub mod svg;
 
 /// One line of points.
