@@ -344,7 +344,6 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         }
     }
     // -v: the engine's budget at the end too (effects, rays by kind, totals' errors)
-    let mut rc = rc;
     if s.verbose {
         rc.insert(1, "-v".to_string());
     }
