@@ -48,15 +48,23 @@ fn pictures_become_pngs_of_the_same_size() {
     // not all black, not all white
     let px: Vec<u8> = raw.chunks(97).flat_map(|r| r[1..].to_vec()).collect();
     assert!(px.iter().any(|&v| v > 20) && px.iter().any(|&v| v < 235));
-    // false colour: the scale on stderr, a pure ramp colour in every pixel (blue..red)
+    // false colour: the scale on stderr, a pure ramp colour in every pixel of the picture
+    // (blue..red), and a legend strip to its right (the colour bar and black label text)
     let mut c = common::fenestra("hdr2png");
     c.args(["-f", "1000"]).arg(&pic);
     let out = c.output().unwrap();
     assert!(out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("1000.0000 (red) cd/m2"));
-    let (_, _, raw) = decode(&out.stdout);
-    for row in raw.chunks(97) {
-        for p in row[1..].chunks(3) {
+    let (w, h, raw) = decode(&out.stdout);
+    assert!(w > 32 && h >= 26, "{w}×{h}");
+    let stride = 1 + 3 * w as usize;
+    let pixel = |x: usize, y: usize| {
+        let k = y * stride + 1 + 3 * x;
+        [raw[k], raw[k + 1], raw[k + 2]]
+    };
+    for y in 0..26 {
+        for x in 0..32 {
+            let p = pixel(x, y);
             // the ramp has at most two of red, green, blue lit together, never all three
             assert!(
                 p.iter().filter(|&&v| v > 0).count() <= 2 || p[0] == 0 || p[2] == 0,
@@ -64,6 +72,19 @@ fn pictures_become_pngs_of_the_same_size() {
             );
         }
     }
+    let legend: Vec<[u8; 3]> = (0..h as usize)
+        .flat_map(|y| (32..w as usize).map(move |x| (x, y)))
+        .map(|(x, y)| pixel(x, y))
+        .collect();
+    assert!(legend.contains(&[0, 0, 0]), "label text");
+    assert!(
+        legend.iter().any(|p| p[0] > 200 && p[1] < 60 && p[2] < 60),
+        "the red end of the bar"
+    );
+    assert!(
+        legend.iter().any(|p| p[2] > 200 && p[0] < 60 && p[1] < 60),
+        "the blue end of the bar"
+    );
 }
 
 #[test]

@@ -7,7 +7,8 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 
-const USAGE: &str = "[-e stops | -m mult] [-g gamma] [-f max|auto] [-o out.png] [picture.hdr | -]";
+const USAGE: &str =
+    "[-e stops | -m mult] [-g gamma] [-f max|auto [-i]] [-o out.png] [picture.hdr | -]";
 
 /// Radiance's luminous efficacy of its RGB white (lm/W).
 const EFFICACY: f64 = 179.0;
@@ -42,7 +43,7 @@ fn ramp(t: f64) -> [f64; 3] {
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
     if args.iter().skip(1).any(|a| a == "--help") {
         println!(
-            "{} {USAGE}\nWrites a Radiance picture as an 8-bit PNG (standard output unless -o).\nOptions:\n  -e stops     exposure change from the automatic one (log-average luminance to 18% grey)\n  -m mult      a fixed multiplier instead of the automatic exposure\n  -g gamma     display gamma (default 2.2)\n  -f max|auto  false colour: luminance 0..max cd/m2 (179 x Radiance's brightness; lux for an irradiance picture) blue to red; auto: the 99th percentile\n  -o file      output file\nSee docs/tools/hdr2png.md.",
+            "{} {USAGE}\nWrites a Radiance picture as an 8-bit PNG (standard output unless -o).\nOptions:\n  -e stops     exposure change from the automatic one (log-average luminance to 18% grey)\n  -m mult      a fixed multiplier instead of the automatic exposure\n  -g gamma     display gamma (default 2.2)\n  -f max|auto  false colour: luminance 0..max cd/m2 (179 x Radiance's brightness; lux for an irradiance picture) blue to red, with a legend; auto: the 99th percentile\n  -i           with -f: the picture holds irradiance (the legend says lux)\n  -o file      output file\nSee docs/tools/hdr2png.md.",
             fenestra_cli::prog()
         );
         return Ok(ExitCode::SUCCESS);
@@ -50,6 +51,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let (mut stops, mut mult, mut gamma) = (0.0f64, None::<f64>, 2.2f64);
     let mut falsecolor: Option<Option<f64>> = None;
     let (mut input, mut output) = (None::<String>, None::<String>);
+    let mut irradiance = false;
     let mut i = 1;
     let num = |i: usize| -> Result<f64> {
         let w = args
@@ -99,6 +101,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 output = Some(args.get(i + 1).context("-o needs a file name")?.clone());
                 i += 1;
             }
+            "-i" => irradiance = true,
             a if a.starts_with('-') && a != "-" => {
                 bail!(
                     "unknown option '{a}'\nusage: {} {USAGE}",
@@ -127,6 +130,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         bail!("{name}: empty picture");
     }
     let mut rgb = vec![[0u8; 3]; w * h];
+    let mut legend = None;
     let lum: Vec<f64> = pic.pixels.iter().map(|p| bright(*p)).collect();
     let place = |k: usize| -> usize {
         let (px, sc) = (k % pic.res.scanlen(), k / pic.res.scanlen());
@@ -147,11 +151,13 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 let c = ramp(l * EFFICACY / max);
                 rgb[place(k)] = c.map(|x| (x * 255.0 + 0.5) as u8);
             }
+            let unit = if irradiance { "lux" } else { "cd/m2" };
             eprintln!(
-                "{}: false colour 0 (blue) .. {max:.4} (red) cd/m2 (x179 of Radiance's brightness; lux for an irradiance picture), steps of {:.4} per colour band",
+                "{}: false colour 0 (blue) .. {max:.4} (red) {unit} (x179 of Radiance's brightness), legend ticks every {:.4}",
                 fenestra_cli::prog(),
                 max / 4.0
             );
+            legend = Some((max, unit));
         }
         None => {
             let m = match mult {
@@ -179,6 +185,19 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             );
         }
     }
+    let (w, h, rgb) = match legend {
+        Some((max, unit)) => {
+            let img = fenestra_chart::raster::Raster {
+                width: w,
+                height: h,
+                pixels: rgb,
+            };
+            let ramp8 = |t: f64| ramp(t).map(|x| (x * 255.0 + 0.5) as u8);
+            let l = fenestra_chart::raster::with_legend(&img, max, unit, &ramp8);
+            (l.width, l.height, l.pixels)
+        }
+        None => (w, h, rgb),
+    };
     let png = fenestra_formats::png::encode_rgb8(w, h, &rgb);
     match output {
         Some(o) => {

@@ -4,6 +4,7 @@
 
 pub mod axis;
 pub mod plan;
+pub mod raster;
 pub mod svg;
 
 /// One line of points.
