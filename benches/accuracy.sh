@@ -7,7 +7,8 @@
 #     the 45 sensors of the relative difference, %;
 #   - DA300 and UDI100-2000 over the year (sf_year.wea, 8-18 h): mean over the sensors of |metric - reference|,
 #     percentage points.
-# Knobs: D rays per Klems patch (-c), V ambient divisions (-ad, -ab 6), V bounces (-ab, -ad 4096). Also measured:
+# Knobs: D rays per Klems patch (-c), V ambient divisions (-ad, -ab 6), V bounces (-ab, -ad 4096), V weight limit
+# (-lw, -ab 6 -ad 4096), T from the blind's geometry (genBSDF -c, against genBSDF at a high -c). Also measured:
 # the reference's own standard error (from its replicas: dctimestep -Rv -Rd -Eo) and the three-phase method's own
 # limit (the converged three-phase result against a direct rtrace of the same room with both windows as BSDF
 # materials, averaged over seeds).
@@ -35,14 +36,16 @@ out=$(realpath "$out")
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
 cp examples/three-phase/scene/*.rad examples/three-phase/scene/sensors.pts examples/three-phase/matrices/*.xml \
   examples/three-phase/weather/sf_year.wea "$work/"
-cp tests/fixtures/rtrace_threephase_bsdf/skyfunc_glow.rad "$work/"
+cp tests/fixtures/rtrace_threephase_bsdf/skyfunc_glow.rad examples/genbsdf/blinds_curved20.mgf "$work/"
 cd "$work"
 
 if [ $quick = 1 ]; then
-  D_SET="25 100"; AD_SET="256 1024"; AB_SET="1 2"; SEEDS="1"; MF_SET="1 2"; MF_C=50
+  D_SET="25 100"; AD_SET="256 1024"; AB_SET="1 2"; LW_SET="1e-2 1e-3"; SEEDS="1"; MF_SET="1 2"; MF_C=50
+  T_SET="25"; T_REF=50
   VREF="-ab 6 -ad 1024 -lw 2e-5 -E -Er 2"; DREF=100; DIRECT_SEEDS="1 2"
 else
   D_SET="25 50 100 200 400 800"; AD_SET="256 512 1024 2048 4096 8192"; AB_SET="1 2 3 4"; SEEDS="1 2 3"
+  LW_SET="1e-2 3e-3 1e-3 3e-4 1e-4"; T_SET="25 50 100 200 400"; T_REF=1600
   MF_SET="1 2 4"; MF_C=1000
   VREF="-ab 6 -ad 6250 -lw 2e-5 -E -Er 32"; DREF=4000; DIRECT_SEEDS=$(seq 1 16)
 fi
@@ -75,9 +78,10 @@ D() {
     rtcontrib -n 2 -fo -c "$c" -ff $D_OPTS "$@" -seed "$seed" -e "MF:${MF:-1}" -f reinhart.cal -b rbin -bn Nrbins \
       -o "D_${name}_West.dmx" -m skyglow dmx.oct
 }
-# LUX VNAME DNAME SKY: lux per sensor and time step (both groups summed), data only
+# LUX VNAME DNAME SKY: lux per sensor and time step (both groups summed), data only; TS (environment) is the south
+# window's BSDF (default the bundled blinds_kf.xml)
 LUX() {
-  rmtxop -ff "!dctimestep V_$1_SouthGroup.vmx blinds_kf.xml D_$2_South.dmx $3" \
+  rmtxop -ff "!dctimestep V_$1_SouthGroup.vmx ${TS:-blinds_kf.xml} D_$2_South.dmx $3" \
     + "!dctimestep V_$1_WestGroup.vmx clear_glass_kf.xml D_$2_West.dmx $3" |
     rmtxop -fa -c 47.435 119.93 11.635 - | sed '1,/^$/d'
 }
@@ -130,12 +134,13 @@ done
 tsv=$out/curves.tsv
 printf "# benches/accuracy.sh%s, %s\n# knob\tsetting\tseed\tseconds\tovercast_rms_pct\tclear_rms_pct\tda300_mad_pts\tudi_mad_pts\n" \
   "$([ $quick = 1 ] && echo " --quick")" "$(date -u +%Y-%m-%d)" > "$tsv"
-row() { # KNOB SETTING SEED SECONDS VNAME DNAME
+row() { # KNOB SETTING SEED SECONDS VNAME DNAME   (REF: prefix of the reference results, default ref)
+  local r=${REF:-ref}
   LUX "$5" "$6" overcast.skv > o.dat
   LUX "$5" "$6" clear.skv > c.dat
   METRICS "$5" "$6" > m.dat
-  printf "%s\t%s\t%s\t%.3f\t%s\t%s\t%s\t%s\n" "$1" "$2" "$3" "$4" "$(RMS o.dat ref_overcast.dat)" \
-    "$(RMS c.dat ref_clear.dat)" "$(MAD m.dat ref_metrics.dat 1)" "$(MAD m.dat ref_metrics.dat 2)" >> "$tsv"
+  printf "%s\t%s\t%s\t%.3f\t%s\t%s\t%s\t%s\n" "$1" "$2" "$3" "$4" "$(RMS o.dat ${r}_overcast.dat)" \
+    "$(RMS c.dat ${r}_clear.dat)" "$(MAD m.dat ${r}_metrics.dat 1)" "$(MAD m.dat ${r}_metrics.dat 2)" >> "$tsv"
 }
 for c in $D_SET; do
   for seed in $SEEDS; do
@@ -155,6 +160,25 @@ for b in $AB_SET; do
   echo "== V -ab $b" >&2
   t0=$(now); V t 1 -ab "$b" -ad 4096 -lw 2e-5; t1=$(now)
   row V-ab "$b" 1 "$(elapsed $t0 $t1)" t ref
+done
+
+for w in $LW_SET; do
+  echo "== V -lw $w" >&2
+  t0=$(now); V t 1 -ab 6 -ad 4096 -lw "$w"; t1=$(now)
+  row V-lw "$w" 1 "$(elapsed $t0 $t1)" t ref
+done
+
+# T: the blind's BSDF from its geometry by fenestra's genBSDF at -c N samples per Klems direction, against genBSDF
+# at -c T_REF (V and D the reference)
+echo "== T reference: genBSDF -c $T_REF +mgf blinds_curved20.mgf" >&2
+genBSDF -n 2 -c "$T_REF" +mgf blinds_curved20.mgf > T_ref.xml 2> /dev/null
+TS=T_ref.xml LUX ref ref overcast.skv > refT_overcast.dat
+TS=T_ref.xml LUX ref ref clear.skv > refT_clear.dat
+TS=T_ref.xml METRICS ref ref > refT_metrics.dat
+for c in $T_SET; do
+  echo "== T: genBSDF -c $c" >&2
+  t0=$(now); genBSDF -n 2 -c "$c" +mgf blinds_curved20.mgf > T_t.xml 2> /dev/null; t1=$(now)
+  TS=T_t.xml REF=refT row T "$c" 1 "$(elapsed $t0 $t1)" ref ref
 done
 
 # the method: sky subdivision MF 1, 2, 4 (D at -c MF_C, V the reference) against the direct rtrace
@@ -189,11 +213,13 @@ name() { case $1 in
   D) echo "D: rays per Klems patch, -c" ;;
   V-ad) echo "V: ambient divisions, -ad (-ab 6)" ;;
   V-ab) echo "V: bounces, -ab (-ad 4096)" ;;
+  V-lw) echo "V: weight limit, -lw (-ab 6 -ad 4096)" ;;
+  T) echo "T: genBSDF samples per direction, -c" ;;
 esac; }
 for col in 4:overcast 5:clear; do
   IFS=: read -r k what <<< "$col"
   : > chart_$what.tsv
-  for knob in D V-ad V-ab; do
+  for knob in D V-ad V-ab V-lw T; do
     awk -F'\t' -v K="$knob" -v C="$k" -v N="$(name "$knob")" '$1 == K && $C > 0 { printf "%s\t%s\t%s\n", N, $3, $C }' \
       summary.tsv >> chart_$what.tsv
   done
@@ -201,7 +227,7 @@ done
 for col in 6:da300 7:udi; do
   IFS=: read -r k what <<< "$col"
   : > chart_$what.tsv
-  for knob in D V-ad V-ab; do
+  for knob in D V-ad V-ab V-lw T; do
     awk -F'\t' -v K="$knob" -v C="$k" -v N="$(name "$knob")" '$1 == K && $C > 0 { printf "%s\t%s\t%s\n", N, $3, $C }' \
       summary.tsv >> chart_$what.tsv
   done
@@ -209,11 +235,11 @@ done
 ref_o=$(cat ref_overcast.se); ref_c=$(cat ref_clear.se)
 lim_o=$(RMS ref_overcast.dat direct_overcast.dat); lim_c=$(RMS ref_clear.dat direct_clear.dat)
 errplot -t "Overcast sky (21 Sep 12:00): illuminance at 45 sensors" -x "wall time of the step (s), 2 cores" \
-  -y "rms error against the reference (%)" -g "$(name D)" -g "$(name V-ad)" \
+  -y "rms error against the reference (%)" -g "$(name D)" -g "$(name V-ad)" -g "$(name T)" \
   -H "$ref_o" "the reference's own standard error" \
   -H "$lim_o" "three-phase vs direct rtrace (the method's own limit)" -o "$out/overcast.svg" chart_overcast.tsv
 errplot -t "Clear sky with sun (21 Mar 10:00): illuminance at 45 sensors" -x "wall time of the step (s), 2 cores" \
-  -y "rms error against the reference (%)" -g "$(name D)" -g "$(name V-ad)" \
+  -y "rms error against the reference (%)" -g "$(name D)" -g "$(name V-ad)" -g "$(name T)" \
   -H "$ref_c" "the reference's own standard error" \
   -H "$lim_c" "three-phase vs direct rtrace (the method's own limit)" -o "$out/clear.svg" chart_clear.tsv
 errplot -t "Annual UDI 100-2000 lux (8-18 h) at 45 sensors" -x "wall time of the step (s), 2 cores" \

@@ -85,7 +85,7 @@ fn accuracy_bench_runs_quick() {
         .filter(|l| !l.starts_with('#'))
         .map(|l| l.split('\t').collect())
         .collect();
-    assert_eq!(rows.len(), 6, "{tsv}");
+    assert_eq!(rows.len(), 9, "{tsv}");
     for r in &rows {
         assert_eq!(r.len(), 8, "{r:?}");
         assert!(
