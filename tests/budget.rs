@@ -97,3 +97,55 @@ fn budget_lines_and_the_total_s_error_against_independent_runs() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn genbsdf_and_mkillum_print_their_budget_with_v() {
+    let dir = common::scratch("budget-tools");
+    let mgf = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("examples/genbsdf/blinds_curved20.mgf");
+    let mut g = common::fenestra("genBSDF");
+    g.args(["-v", "-q", "-c", "4", "+mgf"])
+        .arg(&mgf)
+        .current_dir(&dir);
+    let out = g.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("genBSDF: effect: ambient") && err.contains("145 incident directions x "),
+        "{err}"
+    );
+    assert!(
+        err.contains("primary,") && err.contains("indirect"),
+        "{err}"
+    );
+    // mkillum: one window under a glowing sky, -ab 0 (each ray sees the glow)
+    std::fs::write(
+        dir.join("sky.rad"),
+        "void glow skyglow 0 0 4 2 2.5 3 0\nskyglow source sky 0 0 4 0 0 1 180\n",
+    )
+    .unwrap();
+    let oct = common::run_ok(common::fenestra("oconv").arg("sky.rad").current_dir(&dir));
+    std::fs::write(dir.join("s.oct"), oct).unwrap();
+    let mut m = common::fenestra("mkillum");
+    m.args(["-v", "-ab", "0", "s.oct"]).current_dir(&dir);
+    let out = common::run_stdin(
+        m,
+        b"#@mkillum d=4 s=8\nvoid polygon win 0 0 12 0 0 1  0 1 1  1 1 1  1 0 1\n",
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("1 surfaces in") && err.contains("rays traced"),
+        "{err}"
+    );
+    assert!(err.contains("surface win: mean radiance"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use fenestra_genbsdf::{characterise_with, Options};
 
-const USAGE: &str = "[-q][-E errors.xml][{+|-}C][-t3 L | -t4 L [-t pct][{+|-}a]][-c Nsamp][-n Nproc][-r 'render opts'][{+|-}f[orward]][{+|-}b[ackward]][{+|-}mgf][{+|-}geom unit][-dim x0 x1 y0 y1 z0 z1] [input ..]";
+const USAGE: &str = "[-q][-v][-E errors.xml][{+|-}C][-t3 L | -t4 L [-t pct][{+|-}a]][-c Nsamp][-n Nproc][-r 'render opts'][{+|-}f[orward]][{+|-}b[ackward]][{+|-}mgf][{+|-}geom unit][-dim x0 x1 y0 y1 z0 z1] [input ..]";
 
 /// Geometry units genBSDF accepts, with their length in metres.
 const UNITS: [(&str, f64); 5] = [
@@ -31,6 +31,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let mut nproc = 1usize;
     let mut mgf = false;
     let mut quiet = false;
+    let mut verbose = false;
+    let started = std::time::Instant::now();
     let mut error_file: Option<String> = None;
     let mut unit = 1.0;
     let mut render: Vec<String> = Vec::new();
@@ -52,6 +54,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         let a = args[i].as_str();
         let plus = a.starts_with('+');
         match a {
+            "-v" => verbose = true,
             "-c" => {
                 let n = number(i + 1)?;
                 if n.is_nan() || n < 1.0 {
@@ -226,6 +229,22 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     out.flush()?;
     if !quiet && tree.is_none() {
         eprint!("{}", fenestra_genbsdf::summary(&bsdf));
+    }
+    if verbose {
+        let p = fenestra_cli::prog();
+        for n in &got.effects {
+            eprintln!("{p}: effect: {n}");
+        }
+        let r = got.rays;
+        eprintln!(
+            "{p}: {ndir} incident directions x {} samples in {:.2} s; rays traced: {} primary, {} shadow, {} indirect (ambient samples and below), {} specular/transmitted",
+            got.samples,
+            started.elapsed().as_secs_f64(),
+            r.primary,
+            r.shadow,
+            r.indirect,
+            r.specular
+        );
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -8,7 +8,7 @@ use anyhow::{bail, Context, Result};
 use fenestra_illum::Filter;
 use fenestra_trace::{TraceOptions, Tracer};
 
-const USAGE: &str = "[-n N][-w][-E file][render options] scene.{oct,rad} [< file ..]";
+const USAGE: &str = "[-n N][-w][-v][-E file][render options] scene.{oct,rad} [< file ..]";
 
 fn num(args: &[String], i: usize) -> Result<f64> {
     let w = args
@@ -34,6 +34,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     o.ab = 2;
     let mut nproc = 1usize;
     let mut err_file: Option<String> = None;
+    let mut verbose = false;
+    let started = std::time::Instant::now();
     let mut i = 1;
     while i < args.len() {
         let a = args[i].as_str();
@@ -54,6 +56,11 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         }
         if let Some(v) = fenestra_cli::opts::bool_option(a, "w", true) {
             fenestra_cli::set_warnings(v);
+            i += 1;
+            continue;
+        }
+        if let Some(v) = fenestra_cli::opts::bool_option(a, "v", verbose) {
+            verbose = v;
             i += 1;
             continue;
         }
@@ -142,7 +149,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let progress = fenestra_cli::progress::Progress::new(0, "mkillum");
     pool.install(|| -> Result<()> {
         let mut filter = Filter::new(&tracer, o.seed, header);
-        if err_file.is_some() {
+        if err_file.is_some() || verbose {
             filter.errors = Some(Vec::new());
         }
         filter.progress = Some(&progress);
@@ -161,6 +168,13 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         let errs = filter.errors.take();
         filter.progress = None;
         filter.finish()?;
+        if verbose {
+            budget(
+                &tracer,
+                errs.as_deref().unwrap_or(&[]),
+                started.elapsed().as_secs_f64(),
+            );
+        }
         if let (Some(path), Some(errs)) = (&err_file, errs) {
             write_errors(path, &errs)?;
         }
@@ -168,6 +182,36 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     })?;
     progress.finish();
     Ok(ExitCode::SUCCESS)
+}
+
+/// `-v`: the effects switched on, the rays traced by kind and the time, and per surface
+/// its mean luminance with the rms and largest relative standard error of its directions.
+fn budget(tracer: &Tracer, errs: &[fenestra_illum::filter::SurfaceError], seconds: f64) {
+    let p = fenestra_cli::prog();
+    for n in &tracer.effects().notes {
+        eprintln!("{p}: effect: {n}");
+    }
+    let r = tracer.ray_counts();
+    eprintln!(
+        "{p}: {} surfaces in {seconds:.2} s; rays traced: {} primary, {} shadow, {} indirect (ambient samples and below), {} specular/transmitted",
+        errs.len(),
+        r.primary,
+        r.shadow,
+        r.indirect,
+        r.specular
+    );
+    for e in errs {
+        let n = e.rel.len().max(1) as f64;
+        let rms = (e.rel.iter().map(|x| x * x).sum::<f64>() / n).sqrt();
+        let worst = e.rel.iter().fold(0.0f64, |m, x| m.max(*x));
+        eprintln!(
+            "{p}: surface {}: mean radiance {} (luminance units), standard error of its directions rms {:.2}%, largest {:.2}%",
+            e.name,
+            fenestra_cfmt::fmt_e(e.mean, 4),
+            100.0 * rms,
+            100.0 * worst
+        );
+    }
 }
 
 /// The `-E` file: per surface, the mean luminance and each direction's relative standard error.

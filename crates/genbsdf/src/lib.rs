@@ -224,6 +224,10 @@ pub struct Characterised {
     /// With [`Options::errors`]: the same blocks holding each element's standard error
     /// (sr⁻¹), from the spread of the per-sample contributions.
     pub errors: Option<Bsdf>,
+    /// Rays the tracer traced, by kind (for `-v`).
+    pub rays: fenestra_trace::RayCounts,
+    /// What the tracer switched on, and why (for `-v`).
+    pub effects: Vec<String>,
 }
 
 /// Characterises the device `scene` (genBSDF's frame) on the Klems full basis.
@@ -411,6 +415,8 @@ pub fn characterise_with(
         warnings,
         bsdf,
         errors,
+        rays: tracer.ray_counts(),
+        effects: tracer.effects().notes.clone(),
     })
 }
 

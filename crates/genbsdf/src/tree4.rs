@@ -206,6 +206,8 @@ pub fn characterise(
         warnings,
         bsdf,
         errors: None,
+        rays: tracer.ray_counts(),
+        effects: tracer.effects().notes.clone(),
     })
 }
 
