@@ -361,3 +361,122 @@ fn replica_files_hold_k_rows_per_record_whose_mean_is_the_value() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn rmtxop_carries_replicas_as_dctimestep_does() {
+    // the same V·T·D·s with replicas of V and D: rmtxop -E (every operation applied to the
+    // replica deviations) and dctimestep -Rv -Rd -Eo must give the same standard errors
+    // (rmtxop holds values in single precision: 1e-4 relative) and the same result
+    let dir = common::scratch("rmtxop-errors");
+    let b = common::fixture("rtrace_threephase_bsdf");
+    let sensors = std::fs::read(b.join("sensors.pts")).unwrap();
+    let out = v_command(&dir, &["-E", "-Er", "4", "-o", "V.vmx"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let _ = sensors;
+    // D: 8 rays per Klems patch in 4 groups
+    let mut g = common::fenestra("genklemsamp");
+    g.args([
+        "-ff", "-c", "8", "-vd", "0", "-1", "0", "-vu", "0", "0", "1",
+    ])
+    .arg(fx("rcontrib/window_out.rad"));
+    let rays = common::run_ok(&mut g);
+    let mut d = common::fenestra("rtcontrib");
+    d.args([
+        "-c", "8", "-ffa", "-ab", "1", "-ad", "16", "-lw", "1e-2", "-E", "-Er", "4", "-o", "D.dmx",
+    ])
+    .args([
+        "-e",
+        "MF:1",
+        "-f",
+        "reinhart.cal",
+        "-b",
+        "rbin",
+        "-bn",
+        "Nrbins",
+        "-m",
+        "skyglow",
+    ])
+    .arg(b.join("materials.rad"))
+    .arg(b.join("room.rad"))
+    .arg(b.join("exterior.rad"))
+    .arg(fx("rcontrib/sky_dmx.rad"))
+    .current_dir(&dir);
+    let out = common::run_stdin(d, &rays);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let sky = fx("threephase/sky_t4_sep21_1200_overcast.skv");
+    let xml = fx("threephase/blinds_kf.xml");
+    let mut dc = common::fenestra("dctimestep");
+    dc.args([
+        "-Rv",
+        "V.vmx.rep",
+        "-Rd",
+        "D.dmx.rep",
+        "-Eo",
+        "dc.err",
+        "-o",
+        "dc.dat",
+        "V.vmx",
+        &xml,
+        "D.dmx",
+        &sky,
+    ])
+    .current_dir(&dir);
+    common::run_ok(&mut dc);
+    let mut rm = common::fenestra("rmtxop");
+    rm.args([
+        "-fa",
+        "-E",
+        "rm.err",
+        "-R",
+        "V.vmx.rep",
+        "V.vmx",
+        &xml,
+        "-R",
+        "D.dmx.rep",
+        "D.dmx",
+        &sky,
+    ])
+    .current_dir(&dir);
+    let res = common::run_ok(&mut rm);
+    std::fs::write(dir.join("rm.dat"), res).unwrap();
+    let body = |f: &str| {
+        let t = std::fs::read(dir.join(f)).unwrap();
+        let k = t.windows(2).position(|w| w == b"\n\n").unwrap();
+        common::numbers(&t[k + 2..])
+    };
+    for (a, b) in [("dc.err", "rm.err"), ("dc.dat", "rm.dat")] {
+        let (x, y) = (body(a), body(b));
+        assert_eq!(x.len(), y.len(), "{a} {b}");
+        assert_eq!(x.len(), 45 * 3);
+        for (p, q) in x.iter().zip(&y) {
+            assert!(
+                (p - q).abs() <= 1e-4 * p.abs().max(q.abs()) + 1e-9,
+                "{a}: {p} vs {b}: {q}"
+            );
+        }
+    }
+    let head = std::fs::read_to_string(dir.join("rm.err")).unwrap();
+    assert!(
+        head.contains("CONTENTS= Monte Carlo standard error"),
+        "{head}"
+    );
+    // -E without -R (and -R without -E) refused; replicas of another shape refused
+    for args in [
+        &["-E", "x.err", "V.vmx"][..],
+        &["-R", "V.vmx.rep", "V.vmx"],
+        &["-E", "x.err", "-R", "D.dmx.rep", "V.vmx"],
+    ] {
+        let mut rm = common::fenestra("rmtxop");
+        rm.args(args).current_dir(&dir);
+        assert!(!rm.output().unwrap().status.success(), "{args:?}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

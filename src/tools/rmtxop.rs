@@ -7,11 +7,12 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use fenestra_cli::opts::parse_real;
 use fenestra_dc::ops::{is_xml, multiply_chain, Mtx, Source, XmlPart};
+use fenestra_dc::ops_errors::Tracked;
 use fenestra_formats::header::Header;
 use fenestra_formats::matrix::{AsciiLayout, DataFormat, MatrixWriter, WriteOptions};
 
 const USAGE: &str =
-    "Usage: rmtxop [-v][-f{adfc}][-t][-s sf .. | -c ce ..][-rf|-rb] m1 [.+*] .. > mres";
+    "Usage: rmtxop [-v][-f{adfc}][-E errfile][-t][-s sf .. | -c ce ..][-rf|-rb][-R replicas] m1 [.+*] .. > mres";
 
 const HELP: &str = "rmtxop: matrix operations on Radiance matrices, BSDF XML files and pictures
 
@@ -23,7 +24,10 @@ Options before a matrix apply to that matrix only:
   -c ce ..     component transform: N x NCOMP coefficients give N components
                (-c 47.435 119.93 11.635 turns RGB irradiance into illuminance)
   -rf, -rb     for an XML BSDF: front or back reflection instead of transmission
+  -R file      its replicas, as rtcontrib -E -Er K writes them (fenestra; with -E)
 Global options:
+  -E file      write the standard error of every result value here, carried from the
+               inputs' replicas through every operation (fenestra)
   -fa -ff -fd -fc   output as ascii, float, double or RGBE (default: the first input's format)
   -v           report each operation on stderr
 Operators between matrices (evaluated left to right):
@@ -51,10 +55,14 @@ struct Input {
     scale: Option<Vec<f64>>,
     cmat: Option<Vec<f64>>,
     part: XmlPart,
+    /// `-R`: the file of its replicas.
+    replicas: Option<String>,
 }
 
 struct Parsed {
     verbose: bool,
+    /// `-E`: where the result's standard errors go.
+    errors: Option<String>,
     format: Option<DataFormat>,
     inputs: Vec<Input>,
 }
@@ -68,6 +76,8 @@ fn parse(args: &[String]) -> Result<Parsed> {
     let mut cmat: Option<Vec<f64>> = None;
     let mut part = XmlPart::Transmission;
     let mut op: Option<Op> = None;
+    let mut replicas: Option<String> = None;
+    let mut errors: Option<String> = None;
     let mut i = 1;
     // Numbers following -s/-c.
     let numbers = |i: &mut usize, opt: &str| -> Result<Vec<f64>> {
@@ -109,6 +119,17 @@ fn parse(args: &[String]) -> Result<Parsed> {
             "-t" => transpose = !transpose,
             "-s" => scale = Some(numbers(&mut i, a)?),
             "-c" => cmat = Some(numbers(&mut i, a)?),
+            "-R" | "-E" => {
+                let Some(f) = args.get(i) else {
+                    bail!("option '{a}' needs a file name\n{USAGE}");
+                };
+                i += 1;
+                if a == "-R" {
+                    replicas = Some(f.clone());
+                } else {
+                    errors = Some(f.clone());
+                }
+            }
             "-rf" => part = XmlPart::ReflectionFront,
             "-rb" => part = XmlPart::ReflectionBack,
             _ if a.starts_with("-f") && a.len() > 2 => {
@@ -138,6 +159,7 @@ fn parse(args: &[String]) -> Result<Parsed> {
                     scale: scale.take(),
                     cmat: cmat.take(),
                     part,
+                    replicas: replicas.take(),
                 });
                 transpose = false;
                 part = XmlPart::Transmission;
@@ -148,11 +170,18 @@ fn parse(args: &[String]) -> Result<Parsed> {
     if inputs.is_empty() {
         bail!("no input matrix\n{USAGE}");
     }
-    if op.is_some() || transpose || scale.is_some() || cmat.is_some() {
+    if op.is_some() || transpose || scale.is_some() || cmat.is_some() || replicas.is_some() {
         bail!("operator or option after the last matrix\n{USAGE}");
+    }
+    let with_replicas = inputs.iter().any(|i| i.replicas.is_some());
+    if errors.is_some() != with_replicas {
+        bail!(
+            "-E (the result's standard errors) and -R (an input's replicas) go together\n{USAGE}"
+        );
     }
     Ok(Parsed {
         verbose,
+        errors,
         format,
         inputs,
     })
@@ -248,6 +277,17 @@ fn load_done(inp: &Input, mut m: Mtx, verbose: bool) -> Result<Mtx> {
 /// Runs rmtxop.
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let p = parse(&args)?;
+    if let Some(e) = &p.errors {
+        // every input loaded once (a coloured XML's dither draws from one sequence), the
+        // result from the values as without -E, the errors from the replicas
+        let mut tracked = Vec::with_capacity(p.inputs.len());
+        for inp in &p.inputs {
+            tracked.push(load_tracked(inp, p.verbose)?);
+        }
+        let m = evaluate(&p, tracked.iter().map(|t| t.value.clone()).collect())?;
+        write_errors(&p, e, tracked, &args)?;
+        return write_result(&p, m, &args);
+    }
     if p.inputs.len() == 1 && !p.inputs[0].transpose && !is_xml(&p.inputs[0].name) {
         let src = Source::open(&p.inputs[0].name)?;
         let values = src
@@ -261,10 +301,19 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         let m = load_from(&p.inputs[0], src, p.verbose)?;
         return write_result(&p, m, &args);
     }
-    // Left to right; a run of products is multiplied as one chain (cheapest pair first).
-    let mut chain: Vec<(Mtx, String)> = Vec::new();
+    let mut mats = Vec::with_capacity(p.inputs.len());
     for inp in &p.inputs {
-        let m = load(inp, p.verbose)?;
+        mats.push(load(inp, p.verbose)?);
+    }
+    let m = evaluate(&p, mats)?;
+    write_result(&p, m, &args)
+}
+
+/// The result of the loaded inputs `mats` (their own options applied): left to right, a
+/// run of products multiplied as one chain (cheapest pair first).
+fn evaluate(p: &Parsed, mats: Vec<Mtx>) -> Result<Mtx> {
+    let mut chain: Vec<(Mtx, String)> = Vec::new();
+    for (inp, m) in p.inputs.iter().zip(mats) {
         if inp.op == Op::Product || chain.is_empty() {
             chain.push((m, inp.name.clone()));
             continue;
@@ -283,8 +332,98 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         }
         chain.push((acc, String::new()));
     }
-    let m = reduce_chain(chain, p.verbose)?;
-    write_result(&p, m, &args)
+    reduce_chain(chain, p.verbose)
+}
+
+/// One input with its replicas (`-R`) as a tracked matrix, its own options applied.
+fn load_tracked(inp: &Input, verbose: bool) -> Result<Tracked> {
+    let plain = Input {
+        name: inp.name.clone(),
+        op: inp.op,
+        transpose: false,
+        scale: None,
+        cmat: None,
+        part: inp.part,
+        replicas: None,
+    };
+    let value = load(&plain, verbose)?;
+    let mut t = match &inp.replicas {
+        None => Tracked::exact(value),
+        Some(name) => {
+            if is_xml(name) {
+                bail!("{name}: replicas are a matrix file (rtcontrib -E -Er K), not a BSDF");
+            }
+            let raw = fenestra_formats::matrix::Matrix::read(name)?;
+            let k: usize = match raw.header.get("NREPLICAS").map(|v| v.trim().parse()) {
+                Some(Ok(k)) => k,
+                _ => bail!("{name}: no NREPLICAS= line: not a replica file of rtcontrib -Er"),
+            };
+            let reps = Mtx {
+                nrows: raw.nrows,
+                ncols: raw.ncols,
+                ncomp: raw.ncomp,
+                data: raw.data.iter().map(|&x| x as f32).collect(),
+                info: Vec::new(),
+                format: raw.format,
+            };
+            Tracked::with_replicas(value, &reps, k, name)?
+        }
+    };
+    if inp.cmat.is_some() || inp.scale.is_some() {
+        t.map(|m| m.transform(inp.cmat.as_deref(), inp.scale.as_deref()))
+            .with_context(|| inp.name.clone())?;
+    }
+    if inp.transpose {
+        t.map(|m| {
+            m.transpose();
+            Ok(())
+        })?;
+    }
+    Ok(t)
+}
+
+/// rmtxop's `-E`: the loaded inputs left to right (products too), each operation applied to
+/// the value and to every replica deviation; the result's standard errors written to `err`
+/// (the result itself is computed as without `-E`, so its bytes do not change).
+fn write_errors(p: &Parsed, err: &str, tracked: Vec<Tracked>, args: &[String]) -> Result<()> {
+    let mut acc: Option<Tracked> = None;
+    for (inp, t) in p.inputs.iter().zip(tracked) {
+        acc = Some(match acc {
+            None => t,
+            Some(a) => match inp.op {
+                Op::Product => a
+                    .multiply(&t)
+                    .with_context(|| format!("{}: matrix product failed", inp.name))?,
+                Op::Sum => a
+                    .sum(t)
+                    .with_context(|| format!("{}: matrix sum failed", inp.name))?,
+                Op::ElemProduct => a
+                    .elem_mul(&t)
+                    .with_context(|| format!("{}: element-wise product failed", inp.name))?,
+            },
+        });
+    }
+    let t = acc.context("no input matrix")?;
+    let se = t.standard_errors();
+    let mut opts = output_options(p, &se, args)?;
+    if opts.format == DataFormat::Rgbe {
+        opts.format = DataFormat::Ascii;
+    }
+    opts.align_from = Default::default();
+    if let Some(h) = opts.header.as_mut() {
+        h.push("CONTENTS= Monte Carlo standard error (1 sigma) of each value, from the inputs' replicas");
+    }
+    let file = fenestra_cli::output::AtomicFile::create(err)?;
+    let mut w = MatrixWriter::new(file, Some(se.nrows), se.ncols, se.ncomp, &opts)?;
+    let mut row = vec![0.0f64; se.row_len()];
+    for r in 0..se.nrows {
+        for (d, &s) in row.iter_mut().zip(se.row(r)) {
+            *d = f64::from(s);
+        }
+        w.write_row(&row)?;
+    }
+    w.finish()?.commit()?;
+    Ok(())
 }
 
 /// The output header and format for a result shaped like `m`.

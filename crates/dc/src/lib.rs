@@ -3,5 +3,6 @@
 pub mod errors;
 pub mod metrics;
 pub mod ops;
+pub mod ops_errors;
 pub mod steps;
 pub mod timestep;
