@@ -3,8 +3,8 @@
 # Sets: top (the checkout), FENESTRA_BIN, nproc.
 top=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 if [ -z "${FENESTRA_BIN:-}" ]; then
-  echo "== building fenestra (cargo build --release)" >&2
-  cargo build --release --quiet --manifest-path "$top/Cargo.toml" --bins
+  echo "== building fenestra (cargo build --release; 2-5 minutes the first time)" >&2
+  cargo build --release --manifest-path "$top/Cargo.toml" --bins
   target=$(cargo metadata --format-version 1 --no-deps --manifest-path "$top/Cargo.toml" |
     sed -n 's/.*"target_directory":"\([^"]*\)".*/\1/p')
   FENESTRA_BIN="$target/release"

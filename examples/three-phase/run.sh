@@ -20,8 +20,8 @@ set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 top=$(cd "$here/../.." && pwd)
 if [ -z "${FENESTRA_BIN:-}" ]; then
-  echo "== building fenestra (cargo build --release)" >&2
-  cargo build --release --quiet --manifest-path "$top/Cargo.toml" --bins
+  echo "== building fenestra (cargo build --release; 2-5 minutes the first time)" >&2
+  cargo build --release --manifest-path "$top/Cargo.toml" --bins
   target=$(cargo metadata --format-version 1 --no-deps --manifest-path "$top/Cargo.toml" |
     sed -n 's/.*"target_directory":"\([^"]*\)".*/\1/p')
   FENESTRA_BIN="$target/release"
