@@ -37,3 +37,32 @@ fn help_lists_each_option_on_its_own_line() {
         }
     }
 }
+
+#[test]
+fn every_tool_has_its_documentation_page_built_in() {
+    // `fenestra --help` lists the tools; `fenestra doc TOOL` prints docs/tools/TOOL.md, the
+    // same text, for each (so an installed fenestra carries its documentation)
+    let list = common::run_ok(&mut common::fenestra("fenestra").arg("--help"));
+    let text = String::from_utf8_lossy(&list);
+    let tools: Vec<&str> = text
+        .lines()
+        .skip_while(|l| !l.starts_with("tools:"))
+        .skip(1)
+        .map(str::trim)
+        .collect();
+    assert!(tools.len() >= 20, "{text}");
+    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    for t in tools {
+        let page = common::run_ok(&mut common::fenestra("fenestra").args(["doc", t]));
+        let want = std::fs::read(root.join(format!("docs/tools/{t}.md"))).unwrap();
+        assert!(page == want, "fenestra doc {t}");
+    }
+    let out = common::fenestra("fenestra")
+        .args(["doc", "nosuchtool"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    // the help of a tool points at it
+    let help = common::run_ok(&mut common::fenestra("dctimestep").arg("--help"));
+    assert!(String::from_utf8_lossy(&help).contains("fenestra doc dctimestep"));
+}

@@ -1,7 +1,7 @@
 //! checkBSDF: report what a BSDF XML file holds — Radiance's report (header fields, per
 //! component the Lambertian part, largest directional total, angular resolution and
 //! reciprocity error), then fenestra's own section (hemispherical totals for normal and
-//! diffuse incidence, energy check). See docs/tools/checkBSDF.md.
+//! diffuse incidence, energy check). Full documentation: fenestra doc checkBSDF (docs/tools/checkBSDF.md in the source).
 
 use std::fmt::Write as _;
 use std::io::Write;

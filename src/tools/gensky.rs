@@ -123,7 +123,7 @@ Options:
   -o lon       site longitude, degrees west
   -m mer       standard meridian, degrees west (default 120)
   -y year      solar position for that year (Michalsky)
-See docs/tools/gensky.md.";
+Full documentation: fenestra doc gensky (docs/tools/gensky.md in the source).";
 
 /// Runs gensky.
 pub fn run(args: Vec<String>) -> Result<ExitCode> {

@@ -175,7 +175,7 @@ Options:
   -d         sun only (sky patches zero)
   -5         five-phase: the sun into its single nearest patch
   -h         no header
-See docs/tools/genskyvec.md."
+Full documentation: fenestra doc genskyvec (docs/tools/genskyvec.md in the source)."
                 );
                 return Ok(ExitCode::SUCCESS);
             }

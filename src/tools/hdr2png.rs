@@ -43,7 +43,7 @@ fn ramp(t: f64) -> [f64; 3] {
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
     if args.iter().skip(1).any(|a| a == "--help") {
         println!(
-            "{} {USAGE}\nWrites a Radiance picture as an 8-bit PNG (standard output unless -o).\nOptions:\n  -e stops     exposure change from the automatic one (log-average luminance to 18% grey)\n  -m mult      a fixed multiplier instead of the automatic exposure\n  -g gamma     display gamma (default 2.2)\n  -f max|auto  false colour: luminance 0..max cd/m2 (179 x Radiance's brightness; lux for an irradiance picture) blue to red, with a legend; auto: the 99th percentile\n  -i           with -f: the picture holds irradiance (the legend says lux)\n  -o file      output file\nSee docs/tools/hdr2png.md.",
+            "{} {USAGE}\nWrites a Radiance picture as an 8-bit PNG (standard output unless -o).\nOptions:\n  -e stops     exposure change from the automatic one (log-average luminance to 18% grey)\n  -m mult      a fixed multiplier instead of the automatic exposure\n  -g gamma     display gamma (default 2.2)\n  -f max|auto  false colour: luminance 0..max cd/m2 (179 x Radiance's brightness; lux for an irradiance picture) blue to red, with a legend; auto: the 99th percentile\n  -i           with -f: the picture holds irradiance (the legend says lux)\n  -o file      output file\nFull documentation: fenestra doc hdr2png (docs/tools/hdr2png.md in the source).",
             fenestra_cli::prog()
         );
         return Ok(ExitCode::SUCCESS);

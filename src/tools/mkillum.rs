@@ -22,7 +22,7 @@ fn num(args: &[String], i: usize) -> Result<f64> {
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
     if args.iter().skip(1).any(|a| a == "--help") {
         println!(
-            "{} {USAGE}\nReads scene text (from the files after '<', or standard input) and replaces the surfaces selected by #@mkillum directives with illum sources whose distribution is sampled through the scene.\nSee docs/tools/mkillum.md.",
+            "{} {USAGE}\nReads scene text (from the files after '<', or standard input) and replaces the surfaces selected by #@mkillum directives with illum sources whose distribution is sampled through the scene.\nFull documentation: fenestra doc mkillum (docs/tools/mkillum.md in the source).",
             fenestra_cli::prog()
         );
         return Ok(ExitCode::SUCCESS);

@@ -243,7 +243,7 @@ fn load_scene(system: &[String], receivers: &str) -> Result<fenestra_scene::Scen
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
     if args.iter().skip(1).any(|a| a == "--help") {
         println!(
-            "{} {USAGE}\nComputes the flux-transfer matrix from a sender (or rays on standard input with '-') to the receivers marked with #@rfluxmtx directives (h=u|kf|kh|kq|rN|scN|cie, u=, o=).\nSee docs/tools/rfluxmtx.md.",
+            "{} {USAGE}\nComputes the flux-transfer matrix from a sender (or rays on standard input with '-') to the receivers marked with #@rfluxmtx directives (h=u|kf|kh|kq|rN|scN|cie, u=, o=).\nFull documentation: fenestra doc rfluxmtx (docs/tools/rfluxmtx.md in the source).",
             fenestra_cli::prog()
         );
         return Ok(ExitCode::SUCCESS);

@@ -70,7 +70,7 @@ pub fn run_with(
 ) -> Result<ExitCode> {
     if args.iter().skip(1).any(|a| a == "--help") {
         println!(
-            "{} {USAGE}\nTraces rays read from standard input (origin direction; with -I point normal) and writes, for each record, the contribution coefficients of the tracked modifiers per bin.\nSee docs/tools/rtcontrib.md.",
+            "{} {USAGE}\nTraces rays read from standard input (origin direction; with -I point normal) and writes, for each record, the contribution coefficients of the tracked modifiers per bin.\nFull documentation: fenestra doc rtcontrib (docs/tools/rtcontrib.md in the source).",
             fenestra_cli::prog()
         );
         return Ok(ExitCode::SUCCESS);

@@ -30,7 +30,7 @@ const RTRACE_OPTIONS: &str = "Options:
   -e expr -f file  .cal definitions for patterns
   -seed N          random stream seed (fenestra);  -full  no effect selection
   -defaults        print the values in effect;  -version
-See docs/tools/rtrace.md.";
+Full documentation: fenestra doc rtrace (docs/tools/rtrace.md in the source).";
 
 #[derive(Clone, Copy, PartialEq)]
 enum Fmt {

@@ -397,6 +397,10 @@ impl Spec {
         table.push_str(
             "\nOptions use Radiance's syntax: -ab 4, -faf, -vd x y z, -I/-I+/-I-/+I, @optfile, $VAR.",
         );
+        table.push_str(&format!(
+            "\nFull documentation: fenestra doc {0} (docs/tools/{0}.md in the source).",
+            self.prog
+        ));
         let mut cmd = clap::Command::new(self.prog)
             .about(self.about)
             .disable_help_flag(true)
