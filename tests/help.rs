@@ -42,7 +42,7 @@ fn help_lists_each_option_on_its_own_line() {
 fn every_tool_has_its_documentation_page_built_in() {
     // `fenestra --help` lists the tools; `fenestra doc TOOL` prints docs/tools/TOOL.md, the
     // same text, for each (so an installed fenestra carries its documentation)
-    let list = common::run_ok(&mut common::fenestra("fenestra").arg("--help"));
+    let list = common::run_ok(common::fenestra("fenestra").arg("--help"));
     let text = String::from_utf8_lossy(&list);
     let tools: Vec<&str> = text
         .lines()
@@ -53,7 +53,7 @@ fn every_tool_has_its_documentation_page_built_in() {
     assert!(tools.len() >= 20, "{text}");
     let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     for t in tools {
-        let page = common::run_ok(&mut common::fenestra("fenestra").args(["doc", t]));
+        let page = common::run_ok(common::fenestra("fenestra").args(["doc", t]));
         let want = std::fs::read(root.join(format!("docs/tools/{t}.md"))).unwrap();
         assert!(page == want, "fenestra doc {t}");
     }
@@ -63,6 +63,6 @@ fn every_tool_has_its_documentation_page_built_in() {
         .unwrap();
     assert!(!out.status.success());
     // the help of a tool points at it
-    let help = common::run_ok(&mut common::fenestra("dctimestep").arg("--help"));
+    let help = common::run_ok(common::fenestra("dctimestep").arg("--help"));
     assert!(String::from_utf8_lossy(&help).contains("fenestra doc dctimestep"));
 }
