@@ -234,14 +234,14 @@ for col in 6:da300 7:udi; do
 done
 ref_o=$(cat ref_overcast.se); ref_c=$(cat ref_clear.se)
 lim_o=$(RMS ref_overcast.dat direct_overcast.dat); lim_c=$(RMS ref_clear.dat direct_clear.dat)
-errplot -t "Overcast sky (21 Sep 12:00): illuminance at 45 sensors" -x "wall time of the step (s), 2 cores" \
-  -y "rms error against the reference (%)" -g "$(name D)" -g "$(name V-ad)" -g "$(name T)" \
-  -H "$ref_o" "the reference's own standard error" \
-  -H "$lim_o" "three-phase vs direct rtrace (the method's own limit)" -o "$out/overcast.svg" chart_overcast.tsv
-errplot -t "Clear sky with sun (21 Mar 10:00): illuminance at 45 sensors" -x "wall time of the step (s), 2 cores" \
-  -y "rms error against the reference (%)" -g "$(name D)" -g "$(name V-ad)" -g "$(name T)" \
-  -H "$ref_c" "the reference's own standard error" \
-  -H "$lim_c" "three-phase vs direct rtrace (the method's own limit)" -o "$out/clear.svg" chart_clear.tsv
+for sky in "overcast:Overcast sky (21 Sep 12:00)" "clear:Clear sky with sun (21 Mar 10:00)"; do
+  IFS=: read -r s title <<< "$sky"
+  errplot -t "$title: illuminance at 45 sensors" -x "wall time of the step (s), 2 cores" \
+    -y "rms error against the reference (%)" -g "$(name D)" -g "$(name V-ad)" -g "$(name T)" \
+    -H "$(cat ref_$s.se)" "the reference's own standard error" \
+    -H "$(RMS ref_$s.dat direct_$s.dat)" "three-phase vs direct rtrace (the method's own limit)" \
+    -o "$out/$s.svg" chart_$s.tsv
+done
 errplot -t "Annual UDI 100-2000 lux (8-18 h) at 45 sensors" -x "wall time of the step (s), 2 cores" \
   -y "mean |UDI - reference| (percentage points)" -g "$(name D)" -g "$(name V-ad)" \
   -o "$out/udi.svg" chart_udi.tsv

@@ -55,12 +55,7 @@ fn pipeline(dir: &Path, seed: u64, replicas: usize) -> (Vec<f64>, Vec<f64>) {
     .arg(fx("rcontrib/window_vmx.rad"))
     .args(&room)
     .current_dir(dir);
-    let out = common::run_stdin(v, &std::fs::read(b.join("sensors.pts")).unwrap());
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::run_stdin_ok(v, &std::fs::read(b.join("sensors.pts")).unwrap());
     // D: genklemsamp | rtcontrib, 40 rays per Klems patch
     let mut g = common::fenestra("genklemsamp");
     g.args([
@@ -93,12 +88,7 @@ fn pipeline(dir: &Path, seed: u64, replicas: usize) -> (Vec<f64>, Vec<f64>) {
     .arg(b.join("exterior.rad"))
     .arg(fx("rcontrib/sky_dmx.rad"))
     .current_dir(dir);
-    let out = common::run_stdin(d, &rays);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::run_stdin_ok(d, &rays);
     let inputs = if replicas > 0 {
         ["-Rv", "V.rep", "-Rd", "D.rep"]
     } else {
@@ -369,14 +359,12 @@ fn rmtxop_carries_replicas_as_dctimestep_does() {
     // (rmtxop holds values in single precision: 1e-4 relative) and the same result
     let dir = common::scratch("rmtxop-errors");
     let b = common::fixture("rtrace_threephase_bsdf");
-    let sensors = std::fs::read(b.join("sensors.pts")).unwrap();
     let out = v_command(&dir, &["-E", "-Er", "4", "-o", "V.vmx"]);
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let _ = sensors;
     // D: 8 rays per Klems patch in 4 groups
     let mut g = common::fenestra("genklemsamp");
     g.args([
@@ -405,12 +393,7 @@ fn rmtxop_carries_replicas_as_dctimestep_does() {
     .arg(b.join("exterior.rad"))
     .arg(fx("rcontrib/sky_dmx.rad"))
     .current_dir(&dir);
-    let out = common::run_stdin(d, &rays);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::run_stdin_ok(d, &rays);
     let sky = fx("threephase/sky_t4_sep21_1200_overcast.skv");
     let xml = fx("threephase/blinds_kf.xml");
     let mut dc = common::fenestra("dctimestep");

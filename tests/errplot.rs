@@ -59,25 +59,11 @@ fn errplot_draws_a_chart_and_refuses_bad_tables() {
 fn accuracy_bench_runs_quick() {
     // benches/accuracy.sh --quick with the test build: every knob's rows, the four charts and
     // the generated block (numbers not checked: the quick reference is not converged).
-    let exe = std::env::current_exe().unwrap();
-    let bin = exe
-        .parent()
-        .and_then(std::path::Path::parent)
-        .unwrap()
-        .to_path_buf();
     let dir = common::scratch("accuracy-quick");
-    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let out = std::process::Command::new("bash")
-        .arg(root.join("benches/accuracy.sh"))
-        .args(["--quick", "--out"])
-        .arg(&dir)
-        .env("FENESTRA_BIN", &bin)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    common::run_script(
+        "benches/accuracy.sh",
+        &["--quick".as_ref(), "--out".as_ref(), dir.as_os_str()],
+        &[],
     );
     let tsv = std::fs::read_to_string(dir.join("curves.tsv")).unwrap();
     let rows: Vec<Vec<&str>> = tsv

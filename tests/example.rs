@@ -112,27 +112,8 @@ fn climates_example_runs_and_reports_both_climates() {
     // examples/climates/run.sh with the test build: two summary lines (Chicago, Melbourne),
     // 45 sensors and 3650 occupied hours each, metrics within 0..100 %, and a per-sensor
     // table of 45 rows per climate.
-    let exe = std::env::current_exe().unwrap();
-    let bin = exe
-        .parent()
-        .and_then(std::path::Path::parent)
-        .unwrap()
-        .to_path_buf();
     let out_dir = common::scratch("climates");
-    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let out = std::process::Command::new("bash")
-        .arg(root.join("examples/climates/run.sh"))
-        .env("FENESTRA_BIN", &bin)
-        .env("OUT", &out_dir)
-        .env("FENESTRA_NO_PROGRESS", "1")
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = String::from_utf8_lossy(&out.stdout);
+    let text = common::run_script("examples/climates/run.sh", &[], &[("OUT", &out_dir)]);
     for name in ["chicago_tmy3", "melbourne_fl_tmy3"] {
         let line = text
             .lines()
@@ -158,26 +139,8 @@ fn main_example_runs_with_error_bands() {
     // examples/three-phase/run.sh (the README's main command) with the test build: fresh
     // matrices with replicas, the annual time steps with their standard errors, dametrics'
     // table of 45 sensors with bands that contain each metric, the picture as PNG.
-    let exe = std::env::current_exe().unwrap();
-    let bin = exe
-        .parent()
-        .and_then(std::path::Path::parent)
-        .unwrap()
-        .to_path_buf();
     let out_dir = common::scratch("three-phase-main");
-    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let out = std::process::Command::new("bash")
-        .arg(root.join("examples/three-phase/run.sh"))
-        .env("FENESTRA_BIN", &bin)
-        .env("OUT", &out_dir)
-        .env("FENESTRA_NO_PROGRESS", "1")
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::run_script("examples/three-phase/run.sh", &[], &[("OUT", &out_dir)]);
     let table = std::fs::read_to_string(out_dir.join("metrics.txt")).unwrap();
     let lines: Vec<&str> = table.lines().collect();
     assert_eq!(lines.len(), 47, "{table}");

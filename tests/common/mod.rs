@@ -139,6 +139,43 @@ pub fn run_stdin(mut cmd: Command, input: &[u8]) -> std::process::Output {
     out
 }
 
+/// [`run_stdin`], asserting success (the failure shows the tool's stderr).
+pub fn run_stdin_ok(cmd: Command, input: &[u8]) -> std::process::Output {
+    let out = run_stdin(cmd, input);
+    assert!(
+        out.status.success(),
+        "failed ({}): {}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// Runs a repository script (`bash REPO/rel args…`) with the test build's binaries
+/// (`FENESTRA_BIN`), no progress bars and `env`, asserting success; returns its stdout.
+pub fn run_script(rel: &str, args: &[&std::ffi::OsStr], env: &[(&str, &Path)]) -> String {
+    let exe = std::env::current_exe().unwrap();
+    let bin = exe.parent().and_then(Path::parent).unwrap().to_path_buf();
+    let mut c = Command::new("bash");
+    c.arg(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(rel))
+        .args(args)
+        .env("FENESTRA_BIN", &bin)
+        .env("FENESTRA_NO_PROGRESS", "1");
+    for (k, v) in env {
+        c.env(k, v);
+    }
+    let out = c
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run {rel}: {e}"));
+    assert!(
+        out.status.success(),
+        "{rel} failed ({}): {}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
 /// The whitespace-separated numbers of a tool's text output.
 pub fn numbers(out: &[u8]) -> Vec<f64> {
     String::from_utf8_lossy(out)
