@@ -35,6 +35,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let started = std::time::Instant::now();
     let mut error_file: Option<String> = None;
     let mut unit = 1.0;
+    // +geom unit (Radiance's default, in metres): the geometry embedded as MGF; -geom: not
+    let (mut geout, mut unit_name) = (true, "meter".to_string());
     let mut render: Vec<String> = Vec::new();
     let mut tree: Option<(usize, u32)> = None;
     let mut pctcull = 90.0;
@@ -76,11 +78,13 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             "+mgf" | "-mgf" => mgf = plus,
             "+geom" | "-geom" => {
                 let u = value(i + 1)?;
-                unit = UNITS
+                let (name, m) = UNITS
                     .iter()
                     .find(|(n, _)| n.eq_ignore_ascii_case(u))
-                    .map(|(_, m)| *m)
                     .with_context(|| format!("Illegal geometry unit '{u}' (meter, foot, inch, centimeter or millimeter)"))?;
+                unit = *m;
+                unit_name = name.to_string();
+                geout = plus;
                 i += 1;
             }
             "-dim" => {
@@ -203,7 +207,16 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         b.thickness = b.thickness.map(|v| v * unit);
         b
     };
-    let bsdf = in_metres(got.bsdf);
+    let mut bsdf = in_metres(got.bsdf);
+    if geout {
+        bsdf.geometry = Some(fenestra_bsdf::Geometry {
+            unit: unit_name.clone(),
+            mgf: format!(
+                "\n{}",
+                fenestra_genbsdf::geometry::device_mgf(&scene, &got.dim)
+            ),
+        });
+    }
     let comment = format!(
         "Created by: fenestra genBSDF {} ({} samples per direction)",
         fenestra_cli::command_line(&args),

@@ -13,6 +13,7 @@
 //! `BSDF` material reads back): the incident direction (toward the source) mirrored in
 //! x and y, each side's hemisphere folded onto +Z.
 
+pub mod geometry;
 mod summary;
 pub use summary::summary;
 pub mod reduce;
