@@ -132,6 +132,17 @@ fn oracle_reads_our_xml() {
         "{text}"
     );
     assert!(text.contains("Klems_Full"), "{text}");
+    // the device embedded as MGF (+geom meter, the default), as Radiance's genBSDF does
+    assert!(text.contains("Has Geometry: 1"), "{text}");
+    let mut c = fenestra("genBSDF");
+    c.args(["-c", "4", "+mgf", "-geom", "meter"])
+        .arg(fixture("genbsdf/blinds_curved20.mgf"))
+        .current_dir(&dir);
+    std::fs::write(dir.join("nogeom.xml"), run_ok(&mut c)).unwrap();
+    let mut c = o.command("checkBSDF");
+    c.arg("nogeom.xml").current_dir(&dir);
+    let text = String::from_utf8(run_ok(&mut c)).unwrap();
+    assert!(text.contains("Has Geometry: 0"), "{text}");
     let mut c = o.command("rmtxop");
     c.arg("ours.xml").current_dir(&dir);
     let text = String::from_utf8(run_ok(&mut c)).unwrap();
