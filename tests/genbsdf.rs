@@ -829,3 +829,80 @@ fn tensor_tree_colour_blocks_hold_the_slats_chromaticity() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A killed run continues from its checkpoint and writes the same XML as an uninterrupted
+/// run (the command-line comment aside); a checkpoint of another run is refused.
+#[test]
+fn killed_run_resumes_from_its_checkpoint() {
+    let dir = scratch("genbsdf-checkpoint");
+    let mgf = fixture("genbsdf/blinds_curved20.mgf");
+    let args = ["-q", "-n", "2", "-c", "100", "+mgf"];
+    let mut c = fenestra("genBSDF");
+    c.args(args).arg(&mgf).current_dir(&dir);
+    let full = String::from_utf8(run_ok(&mut c)).unwrap();
+    // kill a checkpointed run once 40 directions are in its file
+    let ck = dir.join("ck.txt");
+    let mut c = fenestra("genBSDF");
+    c.args(["-checkpoint", "ck.txt"])
+        .args(args)
+        .arg(&mgf)
+        .current_dir(&dir)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null());
+    let mut child = c.spawn().unwrap();
+    let start = std::time::Instant::now();
+    loop {
+        let lines = std::fs::read_to_string(&ck)
+            .map(|t| t.lines().count())
+            .unwrap_or(0);
+        if lines >= 40 || start.elapsed().as_secs() > 60 {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    let kept = std::fs::read_to_string(&ck)
+        .map(|t| t.lines().count())
+        .unwrap_or(0);
+    assert!(kept > 1, "the killed run left its checkpoint");
+    let mut c = fenestra("genBSDF");
+    c.args(["-checkpoint", "ck.txt"])
+        .args(args)
+        .arg(&mgf)
+        .current_dir(&dir);
+    let out = c.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    if kept < 146 {
+        assert!(err.contains("resuming from 'ck.txt'"), "{err}");
+    }
+    let strip = |t: &str| -> String {
+        t.lines()
+            .filter(|l| !l.contains("Created by"))
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    assert!(
+        strip(&full) == strip(&String::from_utf8_lossy(&out.stdout)),
+        "resumed XML differs"
+    );
+    assert!(
+        !ck.exists(),
+        "the checkpoint is removed when the run completes"
+    );
+    // a checkpoint of another run (other -c) is refused
+    std::fs::write(&ck, "fenestra genBSDF checkpoint 1 0123456789abcdef\n").unwrap();
+    let mut c = fenestra("genBSDF");
+    c.args(["-checkpoint", "ck.txt"])
+        .args(args)
+        .arg(&mgf)
+        .current_dir(&dir);
+    let out = c.output().unwrap();
+    assert!(!out.status.success() && out.stdout.is_empty());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("another run"));
+}

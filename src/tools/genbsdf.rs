@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use fenestra_genbsdf::{characterise_with, Options};
 
-const USAGE: &str = "[-q][-v][-E errors.xml][{+|-}C][-t3 L | -t4 L [-t pct][{+|-}a]][-c Nsamp][-n Nproc][-r 'render opts'][{+|-}f[orward]][{+|-}b[ackward]][{+|-}mgf][{+|-}geom unit][-dim x0 x1 y0 y1 z0 z1] [input ..]";
+const USAGE: &str = "[-q][-v][-checkpoint file][-E errors.xml][{+|-}C][-t3 L | -t4 L [-t pct][{+|-}a]][-c Nsamp][-n Nproc][-r 'render opts'][{+|-}f[orward]][{+|-}b[ackward]][{+|-}mgf][{+|-}geom unit][-dim x0 x1 y0 y1 z0 z1] [input ..]";
 
 /// Geometry units genBSDF accepts, with their length in metres.
 const UNITS: [(&str, f64); 5] = [
@@ -57,6 +57,10 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         let plus = a.starts_with('+');
         match a {
             "-v" => verbose = true,
+            "-checkpoint" => {
+                o.checkpoint = Some(value(i + 1)?.into());
+                i += 1;
+            }
             "-c" => {
                 let n = number(i + 1)?;
                 if n.is_nan() || n < 1.0 {
@@ -173,6 +177,9 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         bail!("no device geometry in the input");
     }
     let pool = fenestra_cli::threads::pool(nproc)?;
+    if tree.is_some() && o.checkpoint.is_some() {
+        bail!("-checkpoint is not supported with tensor trees (-t3, -t4) yet");
+    }
     if tree.is_some() && o.errors {
         bail!("-E is not supported with tensor trees (-t3, -t4) yet");
     }

@@ -13,6 +13,7 @@
 //! `BSDF` material reads back): the incident direction (toward the source) mirrored in
 //! x and y, each side's hemisphere folded onto +Z.
 
+mod checkpoint;
 pub mod geometry;
 mod summary;
 pub use summary::summary;
@@ -61,6 +62,8 @@ pub struct Options {
     pub errors: bool,
     /// Colour (`+C`): CIE-X and CIE-Z blocks beside the `Visible` (Y) ones.
     pub colour: bool,
+    /// A resumable run (`-checkpoint file`, Klems only): directions done are kept there.
+    pub checkpoint: Option<std::path::PathBuf>,
 }
 
 impl Options {
@@ -78,6 +81,7 @@ impl Options {
             trace,
             errors: false,
             colour: false,
+            checkpoint: None,
         }
     }
 }
@@ -255,7 +259,7 @@ pub fn characterise_with(
 ) -> Result<Characterised> {
     let Setup {
         dim,
-        warnings,
+        mut warnings,
         tracer,
         tracked,
     } = setup(scene, opts)?;
@@ -269,6 +273,26 @@ pub fn characterise_with(
     let omega: Vec<f64> = (0..np)
         .map(|o| basis.projected_solid_angle(o).unwrap_or(0.0))
         .collect();
+    let ckpt = match &opts.checkpoint {
+        Some(path) => {
+            let parts = format!(
+                "{nx} {ny} {} {} {} {} {dim:?} {:?} {:?}",
+                opts.forward, opts.backward, opts.errors, opts.colour, opts.trace, scene.prims
+            );
+            let c = checkpoint::Checkpoint::open(path, &checkpoint::key(&parts))?;
+            if c.len() > 0 {
+                warnings.push(format!(
+                    "resuming from '{}': {} of {} incident directions already done",
+                    path.display(),
+                    c.len(),
+                    np * sides(opts).len()
+                ));
+            }
+            Some(c)
+        }
+        None => None,
+    };
+    let fail: std::sync::Mutex<Option<anyhow::Error>> = std::sync::Mutex::new(None);
     let mut blocks = Vec::new();
     let mut error_blocks = Vec::new();
     for (side_k, &(from_room, tdir, rdir)) in sides(opts).iter().enumerate() {
@@ -279,6 +303,15 @@ pub fn characterise_with(
             (0..np)
                 .into_par_iter()
                 .map(|i| {
+                    if let Some([y, y_sq, x, z]) = ckpt.as_ref().and_then(|c| c.get(side_k, i)) {
+                        done();
+                        return PatchSums {
+                            y: y.clone(),
+                            y_sq: y_sq.clone(),
+                            x: x.clone(),
+                            z: z.clone(),
+                        };
+                    }
                     let mut sum = vec![0.0; 2 * np];
                     let mut sq = vec![0.0; if opts.errors { 2 * np } else { 0 }];
                     let mut sx = vec![0.0; if opts.colour { 2 * np } else { 0 }];
@@ -338,15 +371,32 @@ pub fn characterise_with(
                         }
                     }
                     done();
-                    PatchSums {
+                    let sums = PatchSums {
                         y: sum,
                         y_sq: sq,
                         x: sx,
                         z: sz,
+                    };
+                    if let Some(c) = &ckpt {
+                        let all = [
+                            sums.y.clone(),
+                            sums.y_sq.clone(),
+                            sums.x.clone(),
+                            sums.z.clone(),
+                        ];
+                        if let Err(e) = c.put(side_k, i, &all) {
+                            fail.lock()
+                                .unwrap_or_else(|e| e.into_inner())
+                                .get_or_insert(e);
+                        }
                     }
+                    sums
                 })
                 .collect()
         });
+        if let Some(e) = fail.lock().unwrap_or_else(|e| e.into_inner()).take() {
+            return Err(e);
+        }
         let nf = n as f64;
         // the mean over the samples (or its standard error) divided by the projected solid angle
         let matrix = |far_side: bool, channel: Channel| {
@@ -410,6 +460,9 @@ pub fn characterise_with(
         .errors
         .then(|| file("Standard errors", std::mem::take(&mut error_blocks)));
     let bsdf = file("Unnamed", blocks);
+    if let Some(c) = ckpt {
+        c.finish()?;
+    }
     Ok(Characterised {
         dim,
         samples: n,
