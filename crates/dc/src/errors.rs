@@ -35,7 +35,8 @@ impl Uncertainty {
     /// Splits `all`, K replica rows per matrix row (row `r·K + q` is replica q of row r),
     /// into K matrices; `name` is for messages.
     pub fn replicas(all: &Planar, k: usize, name: &str) -> Result<Uncertainty> {
-        if k < 2 || all.rows % k != 0 {
+        // (checked before allocating: rtcontrib -Er writes 2 to 4096)
+        if !(2..=4096).contains(&k) || all.rows == 0 || all.rows % k != 0 {
             bail!(
                 "{name}: {} rows are not a whole number of records of {k} replicas",
                 all.rows

@@ -32,7 +32,9 @@ impl Tracked {
 
     /// `value` with the replicas in `reps` (K·rows rows, row `r·K + q` replica q of row r).
     pub fn with_replicas(value: Mtx, reps: &Mtx, k: usize, name: &str) -> Result<Tracked> {
-        if k < 2
+        // (checked before allocating: rtcontrib -Er writes 2 to 4096)
+        if !(2..=4096).contains(&k)
+            || value.nrows == 0
             || reps.nrows != value.nrows * k
             || reps.ncols != value.ncols
             || reps.ncomp != value.ncomp
