@@ -66,3 +66,23 @@ fn every_tool_has_its_documentation_page_built_in() {
     let help = common::run_ok(common::fenestra("dctimestep").arg("--help"));
     assert!(String::from_utf8_lossy(&help).contains("fenestra doc dctimestep"));
 }
+
+#[test]
+fn the_sampling_tools_list_their_options() {
+    // one line per option (or group of options) in --help, as the other tools
+    for (tool, at_least) in [
+        ("genBSDF", 12),
+        ("mkillum", 5),
+        ("rtcontrib", 12),
+        ("rfluxmtx", 5),
+    ] {
+        let help = common::run_ok(common::fenestra(tool).arg("--help"));
+        let text = String::from_utf8_lossy(&help);
+        let lines = text
+            .lines()
+            .filter(|l| l.starts_with("  -") || l.starts_with("  +"))
+            .count();
+        assert!(lines >= at_least, "{tool}: {lines} option lines\n{text}");
+        assert!(text.contains(&format!("fenestra doc {tool}")), "{tool}");
+    }
+}
