@@ -906,3 +906,51 @@ fn killed_run_resumes_from_its_checkpoint() {
     assert!(!out.status.success() && out.stdout.is_empty());
     assert!(String::from_utf8_lossy(&out.stderr).contains("another run"));
 }
+
+/// `-E` with a tensor tree: the standard errors come as a tree file of the same rank that
+/// the oracle's checkBSDF reads, and they fall as 1/√samples (4× the samples: half the error).
+#[test]
+fn tree_errors_fall_as_one_over_root_samples() {
+    let dir = scratch("genbsdf-tree-errors");
+    let mgf = fixture("genbsdf/blinds_curved20.mgf");
+    let mut mean_se = Vec::new();
+    for c in ["20", "80"] {
+        let mut g = fenestra("genBSDF");
+        g.args([
+            "-q", "-n", "2", "-t4", "3", "-c", c, "-E", "err.xml", "+mgf",
+        ])
+        .arg(&mgf)
+        .current_dir(&dir);
+        run_ok(&mut g);
+        let text = std::fs::read_to_string(dir.join("err.xml")).unwrap();
+        assert!(text.contains("TensorTree4") && text.contains("Standard errors"));
+        // the mean of every number inside the trees' ScatteringData
+        let mut sum = 0.0;
+        let mut n = 0usize;
+        for block in text.split("<ScatteringData>").skip(1) {
+            let data = block.split("</ScatteringData>").next().unwrap();
+            for w in
+                data.split(|ch: char| ch.is_whitespace() || ch == '{' || ch == '}' || ch == ',')
+            {
+                if let Ok(v) = w.parse::<f64>() {
+                    sum += v;
+                    n += 1;
+                }
+            }
+        }
+        assert!(n > 0);
+        mean_se.push(sum / n as f64);
+    }
+    // the sample grid rounds -c to 25 and 90 samples for this 30 × 28.9 cm device (genBSDF -v),
+    // so the errors should fall by √(90/25) = 1.90; the two runs' trees are reduced
+    // differently (their leaves are not the same cells), so the mean over leaves carries
+    // ±0.3 of slack (measured 1.74)
+    let ratio = mean_se[0] / mean_se[1];
+    assert!((ratio - 1.9).abs() < 0.3, "se(-c 20) / se(-c 80) = {ratio}");
+    if let Some(o) = common::oracle() {
+        let mut c = o.command("checkBSDF");
+        c.arg("err.xml").current_dir(&dir);
+        let text = String::from_utf8(run_ok(&mut c)).unwrap();
+        assert!(text.contains("Anisotropic_Tensor_Tree"), "{text}");
+    }
+}

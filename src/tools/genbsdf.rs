@@ -180,9 +180,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     if tree.is_some() && o.checkpoint.is_some() {
         bail!("-checkpoint is not supported with tensor trees (-t3, -t4) yet");
     }
-    if tree.is_some() && o.errors {
-        bail!("-E is not supported with tensor trees (-t3, -t4) yet");
-    }
+
     let sides = u64::from(o.forward) + u64::from(o.backward);
     let ndir = match tree {
         Some((4, l)) => (1u64 << (2 * l)) * sides,

@@ -65,18 +65,24 @@ pub fn characterise(
     let ns = nx * ny;
     let omega = std::f64::consts::PI / ncell as f64;
     let mut blocks = Vec::new();
+    let mut error_blocks = Vec::new();
     for (side_k, &(from_room, tdir, rdir)) in sides(opts).iter().enumerate() {
         let z = if from_room { z1 + 1e-6 } else { z0 - 1e-6 };
         // per incident cell: Y (then X, Z) flux toward the far side (transmission) and back
         // (reflection), channel-major
-        let rows: Vec<(Vec<f64>, Vec<f64>)> = pool.install(|| {
+        // per incident cell: (transmission, reflection), and with -E each outgoing cell's sum
+        // of squared per-sample Y totals (transmission then reflection, 2 × ncell)
+        let rows: Vec<(Vec<f64>, Vec<f64>, Vec<f64>)> = pool.install(|| {
             (0..nin)
                 .into_par_iter()
                 .map(|cell| {
                     let (ix, iy) = (cell / n, cell % n);
                     let mut trans = vec![0.0; nch * ncell];
                     let mut refl = vec![0.0; nch * ncell];
+                    let mut sq = vec![0.0; if opts.errors { 2 * ncell } else { 0 }];
+                    let mut hits: Vec<(usize, f64)> = Vec::new();
                     for k in 0..ns {
+                        hits.clear();
                         let index = ((side_k * nin + cell) * ns + k) as u64;
                         let mut rng = Rng::for_ray(0x7472_6565_3400, index);
                         let (px, py) = plane_point(&mut rng, k, (nx, ny), x0, y0, w, h);
@@ -104,26 +110,78 @@ pub fn characterise(
                             let o = cell_of(d, n);
                             // transmission: on past the device (toward the room for light
                             // from outside, away from it for light from the room)
-                            let to = if (d.z > 0.0) != from_room {
-                                &mut trans
-                            } else {
-                                &mut refl
-                            };
-                            to[o] += dot(y_w);
+                            let is_t = (d.z > 0.0) != from_room;
+                            let to = if is_t { &mut trans } else { &mut refl };
+                            let y = dot(y_w);
+                            to[o] += y;
+                            if opts.errors {
+                                hits.push((if is_t { o } else { ncell + o }, y));
+                            }
                             if nch == 3 {
                                 to[ncell + o] += dot(x_w);
                                 to[2 * ncell + o] += dot(z_w);
                             }
                         });
+                        if opts.errors {
+                            // one sample's total per cell, then its square
+                            hits.sort_unstable_by_key(|h| h.0);
+                            let mut j = 0;
+                            while j < hits.len() {
+                                let (slot, mut v) = hits[j];
+                                j += 1;
+                                while j < hits.len() && hits[j].0 == slot {
+                                    v += hits[j].1;
+                                    j += 1;
+                                }
+                                sq[slot] += v * v;
+                            }
+                        }
                     }
                     done();
-                    (trans, refl)
+                    (trans, refl, sq)
                 })
                 .collect()
         });
         let scale = 1.0 / ns as f64 / omega;
         for (dir, is_trans) in [(tdir, true), (rdir, false)] {
-            let comp = |r: &(Vec<f64>, Vec<f64>)| -> Vec<f64> {
+            if opts.errors {
+                // the standard error of each cell's value, from the spread of the samples'
+                // totals, before reciprocity averaging (with +a an upper bound), reduced as the
+                // values are
+                let nf = ns as f64;
+                let base = if is_trans { 0 } else { ncell };
+                let mut data: Vec<f32> = Vec::with_capacity(nin * ncell);
+                for r in &rows {
+                    let sums = if is_trans { &r.0 } else { &r.1 };
+                    for (s, q) in sums[..ncell].iter().zip(&r.2[base..base + ncell]) {
+                        let se = if ns > 1 {
+                            let var = ((q - s * s / nf) / (nf - 1.0)).max(0.0);
+                            (var / nf).sqrt() / omega
+                        } else {
+                            0.0
+                        };
+                        data.push(se as f32);
+                    }
+                }
+                data.resize(n.pow(rank as u32), 0.0);
+                let text = reduce(
+                    &Grid {
+                        rank,
+                        log2,
+                        data: &data,
+                    },
+                    pctcull,
+                );
+                let tree = TensorTree::parse(rank, &text)
+                    .map_err(|e| anyhow::anyhow!("internal: reduced tree does not parse: {e:?}"))?;
+                error_blocks.push(Block {
+                    wavelength: Wavelength::Visible,
+                    direction: dir,
+                    data_type: "BTDF".into(),
+                    data: BlockData::Tree(tree),
+                });
+            }
+            let comp = |r: &(Vec<f64>, Vec<f64>, Vec<f64>)| -> Vec<f64> {
                 if is_trans {
                     r.0.clone()
                 } else {
@@ -187,8 +245,8 @@ pub fn characterise(
             }
         }
     }
-    let bsdf = Bsdf {
-        name: "Unnamed".into(),
+    let file = |name: &str, blocks: Vec<Block>| Bsdf {
+        name: name.into(),
         width: Some(w),
         height: Some(h),
         thickness: Some(-z0),
@@ -200,12 +258,14 @@ pub fn characterise(
         blocks,
         ..Default::default()
     };
+    let bsdf = file("Unnamed", blocks);
+    let errors = opts.errors.then(|| file("Standard errors", error_blocks));
     Ok(Characterised {
         dim,
         samples: ns,
         warnings,
         bsdf,
-        errors: None,
+        errors,
         rays: tracer.ray_counts(),
         effects: tracer.effects().notes.clone(),
     })
