@@ -70,19 +70,14 @@ fn data_type(b: &Bsdf) -> String {
     match &blk.data {
         BlockData::Tree(t) if t.rank() == 4 => "Anisotropic_Tensor_Tree".into(),
         BlockData::Tree(_) => "Isotropic_Tensor_Tree".into(),
-        BlockData::Klems(m) => {
-            let n = m.incident.name().to_ascii_lowercase();
-            for (k, name) in [
-                ("full", "Klems_Full"),
-                ("half", "Klems_Half"),
-                ("quarter", "Klems_Quarter"),
-            ] {
-                if n.contains(k) {
-                    return name.into();
-                }
-            }
-            "Klems_Custom".into()
-        }
+        // Radiance 6 names a matrix by its number of incident patches (145, 73, 41): the
+        // current 77-patch Klems half basis is reported as Unknown_Matrix there, and here
+        BlockData::Klems(m) => match m.incident.len() {
+            145 => "Klems_Full".into(),
+            73 => "Klems_Half".into(),
+            41 => "Klems_Quarter".into(),
+            _ => "Unknown_Matrix".into(),
+        },
     }
 }
 

@@ -64,6 +64,9 @@ pub struct Options {
     pub colour: bool,
     /// A resumable run (`-checkpoint file`, Klems only): directions done are kept there.
     pub checkpoint: Option<std::path::PathBuf>,
+    /// The Klems basis (`-k kf|kh|kq`, fenestra): full (145 patches, Radiance's genBSDF's
+    /// only one), half (77) or quarter (41).
+    pub basis: &'static KlemsBasis,
 }
 
 impl Options {
@@ -82,6 +85,7 @@ impl Options {
             errors: false,
             colour: false,
             checkpoint: None,
+            basis: KlemsBasis::full(),
         }
     }
 }
@@ -247,7 +251,7 @@ pub fn characterise(
 /// Number of incident directions a run traces (the Klems patches, per side asked for), for
 /// progress bars.
 pub fn directions(opts: &Options) -> u64 {
-    KlemsBasis::full().len() as u64 * (u64::from(opts.forward) + u64::from(opts.backward))
+    opts.basis.len() as u64 * (u64::from(opts.forward) + u64::from(opts.backward))
 }
 
 /// [`characterise`], calling `done` after each incident direction (from worker threads).
@@ -268,7 +272,7 @@ pub fn characterise_with(
     let [x_w, y_w, z_w] = fenestra_bsdf::radiance::rgb_to_xyz_matrix();
     let (nx, ny) = grid(opts.samples.max(1), w, h);
     let n = nx * ny;
-    let basis = KlemsBasis::full();
+    let basis = opts.basis;
     let np = basis.len();
     let omega: Vec<f64> = (0..np)
         .map(|o| basis.projected_solid_angle(o).unwrap_or(0.0))
@@ -276,8 +280,14 @@ pub fn characterise_with(
     let ckpt = match &opts.checkpoint {
         Some(path) => {
             let parts = format!(
-                "{nx} {ny} {} {} {} {} {dim:?} {:?} {:?}",
-                opts.forward, opts.backward, opts.errors, opts.colour, opts.trace, scene.prims
+                "{nx} {ny} {} {} {} {} {} {dim:?} {:?} {:?}",
+                opts.basis.name(),
+                opts.forward,
+                opts.backward,
+                opts.errors,
+                opts.colour,
+                opts.trace,
+                scene.prims
             );
             let c = checkpoint::Checkpoint::open(path, &checkpoint::key(&parts))?;
             if c.len() > 0 {
