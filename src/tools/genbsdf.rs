@@ -22,7 +22,7 @@ const UNITS: [(&str, f64); 5] = [
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
     if args.iter().skip(1).any(|a| a == "--help") {
         println!(
-            "{} {USAGE}\nCharacterises the device geometry (X = width, Y = up, +Z into the room, device at Z <= 0) as a Klems BSDF, or with -t4 L an anisotropic tensor tree (XML on standard output).\nOptions:\n  -c N             samples per incident direction (default 2000; the sample grid rounds it)\n  -k kf|kh|kq      Klems basis: full (default, 145 patches), half (77) or quarter (41)\n  -n N             threads\n  -r 'opts'        render options after genBSDF's -ab 5 -ad 700 -lw 3e-6\n  +f / -f          light from outside (Transmission/Reflection Front) on / off (default off)\n  +b / -b          light from the room (Back) on / off (default on)\n  +C / -C          colour: CIE-X and CIE-Z blocks (trees: CIE-u, CIE-v)\n  -t4 L / -t3 L    anisotropic / isotropic tensor tree, 2^L cells per dimension (2..6)\n  -t pct           tree culling percentile (default 90);  +a / -a  reciprocity averaging\n  +mgf             the inputs are MGF\n  +geom unit       embed the geometry as MGF (default +geom meter); -geom unit: do not; unit of the input\n  -dim x0 x1 y0 y1 z0 z1   the device's extent instead of its bounding box\n  -E file          each element's standard error as a BSDF XML of the same layout (Klems or tree)\n  -checkpoint file resumable run (Klems): continue a killed run\n  -q               no summary;  -v  effects, rays by kind, time\nFull documentation: fenestra doc genBSDF (docs/tools/genBSDF.md in the source).",
+            "{} {USAGE}\nCharacterises the device geometry (X = width, Y = up, +Z into the room, device at Z <= 0) as a Klems BSDF, or with -t4 L an anisotropic tensor tree (XML on standard output).\nOptions:\n  -c N             samples per incident direction (default 2000; the sample grid rounds it)\n  -k kf|kh|kq      Klems basis: full (default, 145 patches), half (77) or quarter (41)\n  -n N             threads\n  -r 'opts'        render options after genBSDF's -ab 5 -ad 700 -lw 3e-6\n  +f / -f          light from outside (Transmission/Reflection Front) on / off (default off)\n  +b / -b          light from the room (Back) on / off (default on)\n  +C / -C          colour: CIE-X and CIE-Z blocks (trees: CIE-u, CIE-v)\n  -t4 L / -t3 L    anisotropic / isotropic tensor tree, 2^L cells per dimension (2..6)\n  -t pct           tree culling percentile (default 90);  +a / -a  reciprocity averaging\n  +mgf             the inputs are MGF\n  +geom unit       embed the geometry as MGF (default +geom meter); -geom unit: do not; unit of the input\n  -dim x0 x1 y0 y1 z0 z1   the device's extent instead of its bounding box\n  -E file          each element's standard error as a BSDF XML of the same layout (Klems or tree)\n  -checkpoint file resumable run: the same command continues a killed one\n  -q               no summary;  -v  effects, rays by kind, time\nFull documentation: fenestra doc genBSDF (docs/tools/genBSDF.md in the source).",
             fenestra_cli::prog()
         );
         return Ok(ExitCode::SUCCESS);
@@ -188,9 +188,6 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let pool = fenestra_cli::threads::pool(nproc)?;
     if tree.is_some() && !std::ptr::eq(o.basis, fenestra_bsdf::KlemsBasis::full()) {
         bail!("-k: a Klems basis, not with tensor trees (-t3, -t4)");
-    }
-    if tree.is_some() && o.checkpoint.is_some() {
-        bail!("-checkpoint is not supported with tensor trees (-t3, -t4) yet");
     }
 
     let sides = u64::from(o.forward) + u64::from(o.backward);

@@ -62,7 +62,7 @@ pub struct Options {
     pub errors: bool,
     /// Colour (`+C`): CIE-X and CIE-Z blocks beside the `Visible` (Y) ones.
     pub colour: bool,
-    /// A resumable run (`-checkpoint file`, Klems only): directions done are kept there.
+    /// A resumable run (`-checkpoint file`): directions done are kept there.
     pub checkpoint: Option<std::path::PathBuf>,
     /// The Klems basis (`-k kf|kh|kq`, fenestra): full (145 patches, Radiance's genBSDF's
     /// only one), half (77) or quarter (41).

@@ -48,7 +48,7 @@ pub fn characterise(
 ) -> Result<Characterised> {
     let Setup {
         dim,
-        warnings,
+        mut warnings,
         tracer,
         tracked,
     } = setup(scene, opts)?;
@@ -64,6 +64,26 @@ pub fn characterise(
     let (nx, ny) = grid(opts.samples.max(1), w, h);
     let ns = nx * ny;
     let omega = std::f64::consts::PI / ncell as f64;
+    let ckpt = match &opts.checkpoint {
+        Some(path) => {
+            let parts = format!(
+                "tree {rank} {log2} {nx} {ny} {} {} {} {} {dim:?} {:?} {:?}",
+                opts.forward, opts.backward, opts.errors, opts.colour, opts.trace, scene.prims
+            );
+            let c = crate::checkpoint::Checkpoint::open(path, &crate::checkpoint::key(&parts))?;
+            if c.len() > 0 {
+                warnings.push(format!(
+                    "resuming from '{}': {} of {} incident directions already done",
+                    path.display(),
+                    c.len(),
+                    nin * sides(opts).len()
+                ));
+            }
+            Some(c)
+        }
+        None => None,
+    };
+    let fail: std::sync::Mutex<Option<anyhow::Error>> = std::sync::Mutex::new(None);
     let mut blocks = Vec::new();
     let mut error_blocks = Vec::new();
     for (side_k, &(from_room, tdir, rdir)) in sides(opts).iter().enumerate() {
@@ -76,6 +96,10 @@ pub fn characterise(
             (0..nin)
                 .into_par_iter()
                 .map(|cell| {
+                    if let Some([t, r, q, _]) = ckpt.as_ref().and_then(|c| c.get(side_k, cell)) {
+                        done();
+                        return (t.clone(), r.clone(), q.clone());
+                    }
                     let (ix, iy) = (cell / n, cell % n);
                     let mut trans = vec![0.0; nch * ncell];
                     let mut refl = vec![0.0; nch * ncell];
@@ -138,10 +162,21 @@ pub fn characterise(
                         }
                     }
                     done();
+                    if let Some(c) = &ckpt {
+                        let all = [trans.clone(), refl.clone(), sq.clone(), Vec::new()];
+                        if let Err(e) = c.put(side_k, cell, &all) {
+                            fail.lock()
+                                .unwrap_or_else(|e| e.into_inner())
+                                .get_or_insert(e);
+                        }
+                    }
                     (trans, refl, sq)
                 })
                 .collect()
         });
+        if let Some(e) = fail.lock().unwrap_or_else(|e| e.into_inner()).take() {
+            return Err(e);
+        }
         let scale = 1.0 / ns as f64 / omega;
         for (dir, is_trans) in [(tdir, true), (rdir, false)] {
             if opts.errors {
@@ -260,6 +295,9 @@ pub fn characterise(
     };
     let bsdf = file("Unnamed", blocks);
     let errors = opts.errors.then(|| file("Standard errors", error_blocks));
+    if let Some(c) = ckpt {
+        c.finish()?;
+    }
     Ok(Characterised {
         dim,
         samples: ns,
