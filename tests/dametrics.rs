@@ -131,6 +131,11 @@ fn bad_input_is_refused_with_a_message() {
         "#?RADIANCE\nNROWS=1\nNCOLS=2\nNCOMP=1\nFORMAT=ascii\n\n1 2\n",
     );
     write(&dir, "t.wea", &wea(&[9.5, 10.5]));
+    write(
+        &dir,
+        "nan.dat",
+        "#?RADIANCE\nNROWS=1\nNCOLS=3\nNCOMP=1\nFORMAT=ascii\n\n1 nan 3\n",
+    );
     write(&dir, "p.pts", "0 0 0 0 0 1\n1 abc\n");
     for (args, want) in [
         (&["-E", "e.err", "ill.dat"][..], "1×2 standard errors"),
@@ -142,6 +147,10 @@ fn bad_input_is_refused_with_a_message() {
         (&["-u", "2000", "100", "ill.dat"], "below the second"),
         (&["-z", "0", "ill.dat"], "positive"),
         (&["-m", "x.svg", "ill.dat"], "-m needs -p"),
+        (
+            &["nan.dat"],
+            "row 1 (sensor), column 2 (hour) is not a finite number",
+        ),
         (&["-p", "p.pts", "ill.dat"], "p.pts, line 2"),
         (&["missing.dat"], "missing.dat"),
         (&[], "one illuminance matrix expected"),

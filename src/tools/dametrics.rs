@@ -59,11 +59,19 @@ fn lux_rows(name: &str) -> Result<(usize, usize, Vec<f64>)> {
         3 => &LUX,
         n => bail!("{name}: {n} components per value (1, lux, or 3, RGB, expected)"),
     };
-    let v = m
+    let v: Vec<f64> = m
         .data
         .chunks(m.ncomp)
         .map(|c| c.iter().zip(w).map(|(x, k)| x * k).sum())
         .collect();
+    // a metric over a value that is not a number would be one too: refused, with its place
+    if let Some(k) = v.iter().position(|x| !x.is_finite()) {
+        bail!(
+            "{name}: row {} (sensor), column {} (hour) is not a finite number; no metric can use it",
+            k / m.ncols.max(1) + 1,
+            k % m.ncols.max(1) + 1
+        );
+    }
     Ok((m.nrows, m.ncols, v))
 }
 
