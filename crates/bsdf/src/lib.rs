@@ -8,6 +8,7 @@ pub mod model;
 pub mod radiance;
 pub mod read;
 pub mod tree;
+pub mod tree_klems;
 pub(crate) mod tree_load;
 pub mod tree_render;
 pub mod write;

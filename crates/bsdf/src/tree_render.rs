@@ -294,6 +294,33 @@ impl Slice {
         self.cells.smallest
     }
 
+    /// Spreads the slice over directions: each leaf as a grid of points at most `h` apart in
+    /// the unit square (uniform in projected solid angle), each point with its share of the
+    /// leaf's value × projected solid angle; `f` receives the direction and the share.
+    pub fn spread(&self, h: f64, f: &mut dyn FnMut([f64; 3], f64)) {
+        let mut before = 0.0;
+        for &(cum, _, edge) in self.cells.leaves.iter() {
+            let k = ((edge / h).ceil() as usize).clamp(1, 1024);
+            let share = (cum - before) / (k * k) as f64;
+            let x = 0.5 * (before + cum) / self.total.max(f64::MIN_POSITIVE);
+            before = cum;
+            for a in 0..k {
+                for b in 0..k {
+                    let (u, w) = ((a as f64 + 0.5) / k as f64, (b as f64 + 0.5) / k as f64);
+                    if let Some(d) = self.sample(x, u, w) {
+                        f(d, share);
+                    }
+                }
+            }
+        }
+    }
+
+    /// An identity shared by every view whose slice spreads to the same directions (rank-4
+    /// trees: views in the same finest cell); `None` for rank 3 (the slice turns with the view).
+    pub fn shared_id(&self) -> Option<(usize, bool)> {
+        (self.rank == 4).then_some((Arc::as_ptr(&self.cells) as usize, self.reverse))
+    }
+
     /// A direction drawn in proportion to value × projected solid angle: `x` picks the
     /// leaf, `u`, `w` the point in it (uniform in projected solid angle).
     pub fn sample(&self, x: f64, u: f64, w: f64) -> Option<[f64; 3]> {

@@ -3,7 +3,8 @@
 //! the BSDF's incident Klems patches, light sources added explicitly (a sun is not lost in
 //! a patch of 0.05 sr), and the illum's distribution is the transmission matrix applied to
 //! it, at the BSDF's own resolution. The scene must be the outside as seen from the window
-//! (as for a daylight matrix: no window material in the opening).
+//! (as for a daylight matrix: no window material in the opening). A tensor-tree file is
+//! first projected on the full Klems basis (`fenestra_bsdf::tree_klems`).
 
 use std::sync::Arc;
 
@@ -47,8 +48,22 @@ pub fn load(name: &str) -> Result<Arc<BsdfData>> {
         .with_context(|| format!("cannot find BSDF file '{name}' (searched RAYPATH)"))?;
     let b = fenestra_bsdf::read_file(&path)
         .map_err(|e| anyhow::anyhow!("cannot load BSDF file '{}': {e}", path.display()))?;
-    let t = fenestra_bsdf::radiance::transmission_matrix(&b)
-        .map_err(|e| anyhow::anyhow!("BSDF file '{}': {e}", path.display()))?;
+    let t = match fenestra_bsdf::radiance::transmission_matrix(&b) {
+        Ok(t) => t,
+        // a tensor tree: its transmission projected on the full Klems basis
+        Err(e) => match fenestra_bsdf::tree_render::TreeBsdf::load(&b) {
+            Some(tree) => {
+                let full = KlemsBasis::full();
+                if !tree.has(fenestra_bsdf::tree_render::Lobe::Transmission, true)
+                    && tree.lambertian(fenestra_bsdf::tree_render::Lobe::Transmission, true) <= 0.0
+                {
+                    bail!("BSDF file '{}' has no transmission", path.display());
+                }
+                fenestra_bsdf::tree_klems::tree_transmission_matrix(&tree, full)
+            }
+            None => bail!("BSDF file '{}': {e}", path.display()),
+        },
+    };
     let (Some(outgoing), Some(incident)) = (basis_of(t.rows), basis_of(t.cols)) else {
         bail!(
             "BSDF file '{}': a {}x{} transmission matrix is not on a Klems full, half or quarter basis",
