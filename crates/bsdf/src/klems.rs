@@ -37,6 +37,9 @@ pub struct KlemsBasis {
     name: String,
     rings: Vec<Ring>,
     len: usize,
+    /// cos of each ring's upper polar bound (all rings but the last): the ring of a unit
+    /// direction found from its z without an arc cosine.
+    cos_hi: Vec<f64>,
 }
 
 /// Error building a basis from ring bounds.
@@ -101,10 +104,15 @@ impl KlemsBasis {
                 what: format!("last ring must end at 90 degrees, not {lo}"),
             });
         }
+        let cos_hi = out[..out.len() - 1]
+            .iter()
+            .map(|r| r.theta_hi.to_radians().cos())
+            .collect();
         Ok(KlemsBasis {
             name: name.to_string(),
             rings: out,
             len: first,
+            cos_hi,
         })
     }
 
@@ -191,6 +199,41 @@ impl KlemsBasis {
             .iter()
             .position(|ring| theta_deg <= ring.theta_hi)
             .unwrap_or(last);
+        Some(self.in_ring(r, phi_deg))
+    }
+
+    /// The patch holding a local direction (any length; `z` along the normal), or `None` for a
+    /// direction with negative `z` (wrong hemisphere), zero length or non-finite components.
+    pub fn patch(&self, v: [f64; 3]) -> Option<usize> {
+        let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        if !(len > 0.0 && len.is_finite()) {
+            return None;
+        }
+        let u = [v[0] / len, v[1] / len, v[2] / len];
+        // fast path: the ring from z against the bounds' cosines, unless z lies within
+        // 1e-12 of one (or of the horizon), where the arc cosine decides as Radiance does
+        const NEAR: f64 = 1e-12;
+        if u[2] > NEAR && self.cos_hi.iter().all(|c| (u[2] - c).abs() > NEAR) {
+            let r = self
+                .cos_hi
+                .iter()
+                .position(|&c| u[2] >= c)
+                .unwrap_or(self.rings.len() - 1);
+            let mut a = u[1].atan2(u[0]);
+            if a < 0.0 {
+                a += 2.0 * PI;
+            }
+            return Some(self.in_ring(r, a / (PI / 180.0)));
+        }
+        let (theta, phi) = local_angles(u);
+        if theta > 90.0 {
+            return None;
+        }
+        self.patch_at(theta, phi)
+    }
+
+    /// The patch of ring `r` at azimuth `phi_deg` (finite).
+    fn in_ring(&self, r: usize, phi_deg: f64) -> usize {
         let ring = &self.rings[r];
         let mut azi = phi_deg % 360.0;
         if azi < 0.0 {
@@ -202,21 +245,7 @@ impl KlemsBasis {
         } else {
             0
         };
-        Some(ring.first + j.min(ring.nphi - 1))
-    }
-
-    /// The patch holding a local direction (any length; `z` along the normal), or `None` for a
-    /// direction with negative `z` (wrong hemisphere), zero length or non-finite components.
-    pub fn patch(&self, v: [f64; 3]) -> Option<usize> {
-        let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-        if !(len > 0.0 && len.is_finite()) {
-            return None;
-        }
-        let (theta, phi) = local_angles([v[0] / len, v[1] / len, v[2] / len]);
-        if theta > 90.0 {
-            return None;
-        }
-        self.patch_at(theta, phi)
+        ring.first + j.min(ring.nphi - 1)
     }
 
     /// Polar bounds (degrees) and azimuth range (degrees, centre ± half width) of a patch.
@@ -457,6 +486,49 @@ mod tests {
                 }
                 let r = b.rotate180(p).unwrap();
                 assert_eq!(b.rotate180(r), Some(p));
+            }
+        }
+    }
+
+    #[test]
+    fn fast_patch_lookup_is_the_arc_cosine_one() {
+        // random directions, and directions on and 1e-13 either side of every ring bound
+        let slow = |b: &KlemsBasis, v: [f64; 3]| {
+            let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            let (t, p) = local_angles([v[0] / len, v[1] / len, v[2] / len]);
+            if t > 90.0 {
+                None
+            } else {
+                b.patch_at(t, p)
+            }
+        };
+        let mut x: u64 = 0x2545_f491_4f6c_dd1d;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for b in [
+            KlemsBasis::full(),
+            KlemsBasis::half(),
+            KlemsBasis::quarter(),
+        ] {
+            for _ in 0..200_000 {
+                let (z, phi) = (next(), next() * 2.0 * PI);
+                let r = (1.0 - z * z).sqrt();
+                let v = [r * phi.cos(), r * phi.sin(), z];
+                assert_eq!(b.patch(v), slow(b, v), "{v:?}");
+            }
+            for ring in &b.rings {
+                for d in [-1e-13, 0.0, 1e-13] {
+                    let t = (ring.theta_hi + d).to_radians();
+                    for k in 0..64 {
+                        let phi = k as f64 * PI / 32.0;
+                        let v = [t.sin() * phi.cos(), t.sin() * phi.sin(), t.cos()];
+                        assert_eq!(b.patch(v), slow(b, v), "{v:?}");
+                    }
+                }
             }
         }
     }

@@ -220,6 +220,27 @@ pub(crate) fn plane_point(
     )
 }
 
+/// The seed of the sample plane and directions: `base`, changed by the render options'
+/// `-seed` (`-r '-seed N'`), so runs with different seeds are independent replicates.
+pub(crate) fn sample_seed(base: u64, opts: &Options) -> u64 {
+    base ^ opts.trace.seed.wrapping_mul(0x9e37_79b9_7f4a_7c15)
+}
+
+/// The direction stratum of each of `n` samples of one incident direction (`key`): a
+/// random permutation of `0..n`, so sample k's position cell (k on the sample grid) and
+/// its direction stratum are paired at random. Both are stratified; pairing them in order
+/// would correlate where a ray starts with where it heads (a bias when the two interact,
+/// as across a blind's slats), pairing them at random leaves the pair uniform.
+pub(crate) fn direction_strata(seed: u64, key: u64, n: usize) -> Vec<u32> {
+    let mut perm: Vec<u32> = (0..n as u32).collect();
+    let mut rng = fenestra_trace::rng::Rng::for_ray(seed ^ 0x7065_726d_7574, key);
+    for j in (1..n).rev() {
+        let r = (rng.next_f64() * (j + 1) as f64) as usize;
+        perm.swap(j, r.min(j));
+    }
+    perm
+}
+
 /// What a run measured: the bounding box used and the BSDF.
 pub struct Characterised {
     /// `[x0, x1, y0, y1, z0, z1]`.
@@ -303,6 +324,7 @@ pub fn characterise_with(
         None => None,
     };
     let fail: std::sync::Mutex<Option<anyhow::Error>> = std::sync::Mutex::new(None);
+    let seed = sample_seed(0x6e6e_b5df, opts);
     let mut blocks = Vec::new();
     let mut error_blocks = Vec::new();
     for (side_k, &(from_room, tdir, rdir)) in sides(opts).iter().enumerate() {
@@ -327,12 +349,15 @@ pub fn characterise_with(
                     let mut sx = vec![0.0; if opts.colour { 2 * np } else { 0 }];
                     let mut sz = sx.clone();
                     let mut hits: Vec<(usize, f64)> = Vec::new();
-                    for k in 0..n {
+                    let strata = direction_strata(seed, (side_k * np + i) as u64, n);
+                    for (k, &stratum) in strata.iter().enumerate() {
                         hits.clear();
                         let index = ((side_k * np + i) * n + k) as u64;
-                        let mut rng = fenestra_trace::rng::Rng::for_ray(0x6e6e_b5df, index);
+                        let mut rng = fenestra_trace::rng::Rng::for_ray(seed, index);
                         let (px, py) = plane_point(&mut rng, k, (nx, ny), x0, y0, w, h);
-                        let (u0, u1) = (rng.next_f64(), rng.next_f64());
+                        // the direction within the patch, stratified (Hilbert order)
+                        let t = (f64::from(stratum) + rng.next_f64()) / n as f64;
+                        let (u0, u1) = fenestra_trace::rng::spread2(t, &mut rng);
                         let Some(b) = basis.sample_projected(i, u0, u1) else {
                             continue;
                         };

@@ -16,7 +16,9 @@ use fenestra_trace::DVec3;
 use rayon::prelude::*;
 
 use crate::reduce::{reciprocity, reduce, Grid};
-use crate::{grid, plane_point, setup, sides, Characterised, Options, Setup};
+use crate::{
+    direction_strata, grid, plane_point, sample_seed, setup, sides, Characterised, Options, Setup,
+};
 
 /// The grid cell of a unit direction of travel (its x and y on the disk).
 fn cell_of(d: DVec3, n: usize) -> usize {
@@ -84,6 +86,7 @@ pub fn characterise(
         None => None,
     };
     let fail: std::sync::Mutex<Option<anyhow::Error>> = std::sync::Mutex::new(None);
+    let seed = sample_seed(0x7472_6565_3400, opts);
     let mut blocks = Vec::new();
     let mut error_blocks = Vec::new();
     for (side_k, &(from_room, tdir, rdir)) in sides(opts).iter().enumerate() {
@@ -105,12 +108,13 @@ pub fn characterise(
                     let mut refl = vec![0.0; nch * ncell];
                     let mut sq = vec![0.0; if opts.errors { 2 * ncell } else { 0 }];
                     let mut hits: Vec<(usize, f64)> = Vec::new();
-                    for k in 0..ns {
+                    let strata = direction_strata(seed, (side_k * nin + cell) as u64, ns);
+                    for (k, &stratum) in strata.iter().enumerate() {
                         hits.clear();
                         let index = ((side_k * nin + cell) * ns + k) as u64;
-                        let mut rng = Rng::for_ray(0x7472_6565_3400, index);
+                        let mut rng = Rng::for_ray(seed, index);
                         let (px, py) = plane_point(&mut rng, k, (nx, ny), x0, y0, w, h);
-                        let t = (k as f64 + rng.next_f64()) / ns as f64;
+                        let t = (f64::from(stratum) + rng.next_f64()) / ns as f64;
                         let (s1, s2) = spread2(t, &mut rng);
                         let (dx, dy) = if rank == 4 {
                             square_to_disk((ix as f64 + s1) / n as f64, (iy as f64 + s2) / n as f64)
