@@ -184,7 +184,7 @@ fn inv3(m: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
 }
 
 /// Desaturates `rgb` towards the grey of luminance `y` until no channel is negative.
-fn clip_gamut(rgb: [f64; 3], y: f64) -> [f64; 3] {
+pub(crate) fn clip_gamut(rgb: [f64; 3], y: f64) -> [f64; 3] {
     let mut t = 1.0f64;
     for v in rgb {
         if v < 0.0 && y - v > 0.0 {

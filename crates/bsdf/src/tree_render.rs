@@ -32,6 +32,39 @@ struct Comp {
     root: Node,
     /// Edge of the smallest leaf: views in the same cell of this size share a slice.
     finest: f64,
+    /// CIE u′ and v′ trees of a coloured component (same rank and coordinates as `root`).
+    uv: Option<(Node, Node)>,
+}
+
+impl Comp {
+    /// RGB per unit luminance at tree position `pos` (ones for a grey component).
+    fn colour_at(&self, pos: &[f64; 4]) -> [f64; 3] {
+        match &self.uv {
+            Some((u, v)) => {
+                let up = f64::from(leaf_at(u, self.rank, pos).value);
+                let vp = f64::from(leaf_at(v, self.rank, pos).value);
+                uv_rgb(up, vp)
+            }
+            None => [1.0; 3],
+        }
+    }
+}
+
+/// RGB (the renderer's primaries) of CIE (u′, v′) at unit luminance, desaturated into the
+/// gamut as the Klems colours are; grey for a degenerate chromaticity.
+fn uv_rgb(u: f64, v: f64) -> [f64; 3] {
+    let d = 6.0 * u - 16.0 * v + 12.0;
+    if !(d.is_finite() && d > 0.0 && v > 0.0) {
+        return [1.0; 3];
+    }
+    let (x, y) = (9.0 * u / d, 4.0 * v / d);
+    if y <= 0.0 {
+        return [1.0; 3];
+    }
+    let xyz = [x / y, 1.0, (1.0 - x - y) / y];
+    let m = crate::radiance::xyz_to_rgb_matrix();
+    let rgb = [0, 1, 2].map(|r| m[r][0] * xyz[0] + m[r][1] * xyz[1] + m[r][2] * xyz[2]);
+    crate::radiance::clip_gamut(rgb, 1.0)
 }
 
 /// The leaves of one slice: (cumulative weight, lower corner in the free dimensions, edge),
@@ -40,6 +73,8 @@ struct Comp {
 struct Cells {
     leaves: Vec<(f64, [f64; 2], f64)>,
     smallest: f64,
+    /// Σ weight × RGB per unit luminance over the leaves (the coloured total).
+    rgb: [f64; 3],
 }
 
 /// A slice's cache key: component, whether it is used in its own direction, incident cell.
@@ -57,6 +92,8 @@ pub struct TreeBsdf {
     comps: [Option<Comp>; 4],
     /// Hemispherical Lambertian part (π × the value split off) per component.
     lamb: [f64; 4],
+    /// The same in RGB.
+    lamb_rgb: [[f64; 3]; 4],
     /// Slices already computed, by component, direction of use and incident cell.
     cache: Mutex<HashMap<SliceKey, Arc<Cells>>>,
 }
@@ -77,17 +114,25 @@ impl TreeBsdf {
     pub fn load(b: &Bsdf) -> Option<TreeBsdf> {
         let f = TreeFile::load(b)?;
         let lamb = std::array::from_fn(|k| f.lamb[k].y);
+        let m = crate::radiance::xyz_to_rgb_matrix();
+        let lamb_rgb = std::array::from_fn(|k| {
+            let (xyz, y) = (f.lamb[k].xyz, f.lamb[k].y);
+            let rgb = [0, 1, 2].map(|r| m[r][0] * xyz[0] + m[r][1] * xyz[1] + m[r][2] * xyz[2]);
+            crate::radiance::clip_gamut(rgb, y)
+        });
         let comps = f.trees.map(|t| {
             t.map(|t| Comp {
                 rank: t.rank,
                 side: t.side,
                 finest: smallest_leaf_edge(&t.root),
+                uv: t.u.zip(t.v),
                 root: t.root,
             })
         });
         Some(TreeBsdf {
             comps,
             lamb,
+            lamb_rgb,
             cache: Mutex::new(HashMap::new()),
         })
     }
@@ -95,6 +140,23 @@ impl TreeBsdf {
     /// The hemispherical Lambertian part of `lobe` for a view on the front or back side.
     pub fn lambertian(&self, lobe: Lobe, front: bool) -> f64 {
         self.lamb[candidates(lobe, front)[0]]
+    }
+
+    /// [`TreeBsdf::lambertian`] in RGB (the Lambertian part's own colour).
+    pub fn lambertian_rgb(&self, lobe: Lobe, front: bool) -> [f64; 3] {
+        self.lamb_rgb[candidates(lobe, front)[0]]
+    }
+
+    /// Colour (RGB per unit luminance) of the leaf holding view `v` and light `l`: from the
+    /// component's u′, v′ trees, ones for a grey component.
+    pub fn colour(&self, lobe: Lobe, front: bool, v: [f64; 3], l: [f64; 3]) -> [f64; 3] {
+        for &k in candidates(lobe, front) {
+            let Some(c) = &self.comps[k] else { continue };
+            if let Some((i, o)) = orient(c.side, v, l) {
+                return c.colour_at(&position(c.rank, i, o));
+            }
+        }
+        [1.0; 3]
     }
 
     /// Whether the lobe has a tree (its own or, for transmission, the other side's).
@@ -188,6 +250,7 @@ impl TreeBsdf {
                 let mut cells = Cells::default();
                 let mut total = 0.0;
                 let mut smallest = f64::INFINITY;
+                let mut rgb = [0.0; 3];
                 slice_leaves(
                     &c.root,
                     c.rank,
@@ -200,6 +263,15 @@ impl TreeBsdf {
                         if w > 0.0 {
                             total += w;
                             smallest = smallest.min(PI * edge * edge);
+                            // the leaf's colour at its centre (the fixed dimensions as given)
+                            let mut pos = fixed;
+                            for &d in &free {
+                                pos[d] = cmin[d] + 0.5 * edge;
+                            }
+                            let col = c.colour_at(&pos);
+                            for (a, b) in rgb.iter_mut().zip(col) {
+                                *a += w * b;
+                            }
                             cells
                                 .leaves
                                 .push((total, [cmin[free[0]], cmin[free[1]]], edge));
@@ -207,6 +279,7 @@ impl TreeBsdf {
                     },
                 );
                 cells.smallest = if smallest.is_finite() { smallest } else { 0.0 };
+                cells.rgb = rgb;
                 let cells = Arc::new(cells);
                 if let Ok(mut m) = self.cache.lock() {
                     if m.len() < MAX_CACHED {
@@ -287,6 +360,11 @@ impl Slice {
     /// Directional-hemispherical total (Σ value · projected solid angle).
     pub fn total(&self) -> f64 {
         self.total
+    }
+
+    /// [`Slice::total`] in RGB (each leaf in its colour).
+    pub fn total_rgb(&self) -> [f64; 3] {
+        self.cells.rgb
     }
 
     /// Projected solid angle of the smallest leaf of the slice (0 when empty).

@@ -117,7 +117,9 @@ impl LobeData<'_> {
     pub fn hemi_rgb(&self, v: DVec3) -> DVec3 {
         match self {
             LobeData::Klems(c) => c.hemi_rgb(v),
-            LobeData::Tree(..) => DVec3::splat(self.hemi(v)),
+            LobeData::Tree(t, lobe, front) => t
+                .slice(*lobe, *front, v.to_array())
+                .map_or(DVec3::ZERO, |s| DVec3::from(s.total_rgb())),
         }
     }
 
@@ -129,7 +131,8 @@ impl LobeData<'_> {
             LobeData::Tree(t, lobe, front) => {
                 let s = t.slice(*lobe, *front, v.to_array())?;
                 let d = s.sample(u, u0, u1)?;
-                Some((DVec3::from(d), s.total(), DVec3::ONE))
+                let colour = DVec3::from(t.colour(*lobe, *front, v.to_array(), d));
+                Some((DVec3::from(d), s.total(), colour))
             }
         }
     }
@@ -138,7 +141,9 @@ impl LobeData<'_> {
     pub fn colour(&self, v: DVec3, l: DVec3) -> DVec3 {
         match self {
             LobeData::Klems(c) => c.colour(v, l),
-            LobeData::Tree(..) => DVec3::ONE,
+            LobeData::Tree(t, lobe, front) => {
+                DVec3::from(t.colour(*lobe, *front, v.to_array(), l.to_array()))
+            }
         }
     }
 
@@ -394,7 +399,7 @@ pub fn compile(p: &Primitive) -> Result<BsdfMat> {
         }
     };
     if let Some(t) = TreeBsdf::load(&b) {
-        let l = |lobe, front| DVec3::splat(t.lambertian(lobe, front));
+        let l = |lobe, front| DVec3::from(t.lambertian_rgb(lobe, front));
         return Ok(BsdfMat {
             up,
             rf: None,
