@@ -22,7 +22,7 @@ const UNITS: [(&str, f64); 5] = [
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
     if args.iter().skip(1).any(|a| a == "--help") {
         println!(
-            "{} {USAGE}\nCharacterises the device geometry (X = width, Y = up, +Z into the room, device at Z <= 0) as a Klems BSDF, or with -t4 L an anisotropic tensor tree (XML on standard output).\nOptions:\n  -c N             samples per incident direction (default 2000; the sample grid rounds it)\n  -k kf|kh|kq      Klems basis: full (default, 145 patches), half (77) or quarter (41)\n  -n N             threads\n  -r 'opts'        render options after genBSDF's -ab 5 -ad 700 -lw 3e-6\n  +f / -f          light from outside (Transmission/Reflection Front) on / off (default off)\n  +b / -b          light from the room (Back) on / off (default on)\n  +C / -C          colour: CIE-X and CIE-Z blocks (trees: CIE-u, CIE-v)\n  -t4 L / -t3 L    anisotropic / isotropic tensor tree, 2^L cells per dimension (2..6)\n  -t pct           tree culling percentile (default 90);  +a / -a  reciprocity averaging\n  +mgf             the inputs are MGF\n  +geom unit       embed the geometry as MGF (default +geom meter); -geom unit: do not; unit of the input\n  -dim x0 x1 y0 y1 z0 z1   the device's extent instead of its bounding box\n  -E file          each element's standard error as a BSDF XML of the same layout (Klems or tree)\n  -checkpoint file resumable run: the same command continues a killed one\n  -q               no summary;  -v  effects, rays by kind, time\nFull documentation: fenestra doc genBSDF (docs/tools/genBSDF.md in the source).",
+            "{} {USAGE}\nCharacterises the device geometry (X = width, Y = up, +Z into the room, device at Z <= 0) as a Klems BSDF, or with -t4 L an anisotropic tensor tree (XML on standard output).\nOptions:\n  -c N             samples per incident direction (default 2000; the sample grid rounds it)\n  -k kf|kh|kq      Klems basis: full (default, 145 patches), half (77) or quarter (41)\n  -n N             threads\n  -r 'opts'        render options after genBSDF's -ab 5 -ad 700 -lw 3e-6\n  +f / -f          light from outside (Transmission/Reflection Front) on / off (default off)\n  +b / -b          light from the room (Back) on / off (default on)\n  +C / -C          colour: CIE-X and CIE-Z blocks (trees: CIE-u, CIE-v)\n  -t4 L / -t3 L    anisotropic / isotropic tensor tree, 2^L cells per dimension (2..7)\n  -t pct           tree culling percentile (default 90);  +a / -a  reciprocity averaging\n  +mgf             the inputs are MGF\n  +geom unit       embed the geometry as MGF (default +geom meter); -geom unit: do not; unit of the input\n  -dim x0 x1 y0 y1 z0 z1   the device's extent instead of its bounding box\n  -E file          each element's standard error as a BSDF XML of the same layout (Klems or tree)\n  -checkpoint file resumable run: the same command continues a killed one\n  -q               no summary;  -v  effects, rays by kind, time\nFull documentation: fenestra doc genBSDF (docs/tools/genBSDF.md in the source).",
             fenestra_cli::prog()
         );
         return Ok(ExitCode::SUCCESS);
@@ -41,6 +41,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let mut tree: Option<(usize, u32)> = None;
     let mut pctcull = 90.0;
     let mut recip = true;
+    let mut recip_given = false;
     let mut files: Vec<String> = Vec::new();
     let mut i = 1;
     let value = |i: usize| -> Result<&String> {
@@ -111,8 +112,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             "+C" | "-C" => o.colour = plus,
             "-t4" | "-t3" => {
                 let l = number(i + 1)?;
-                if !(2.0..=6.0).contains(&l) || l.fract() != 0.0 {
-                    bail!("{a} {l}: the tree resolution must be a whole number from 2 to 6 (2^L cells per dimension)");
+                if !(2.0..=7.0).contains(&l) || l.fract() != 0.0 {
+                    bail!("{a} {l}: the tree resolution must be a whole number from 2 to 7 (2^L cells per dimension)");
                 }
                 tree = Some((if a == "-t4" { 4 } else { 3 }, l as u32));
                 i += 1;
@@ -125,7 +126,10 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 pctcull = p;
                 i += 1;
             }
-            "+a" | "-a" => recip = plus,
+            "+a" | "-a" => {
+                recip = plus;
+                recip_given = true;
+            }
             "-recover" => bail!(
                 "-recover: fenestra's genBSDF runs in one process and keeps no temporary directory"
             ),
@@ -190,9 +194,27 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         bail!("-k: a Klems basis, not with tensor trees (-t3, -t4)");
     }
 
+    if let Some((rank, l)) = tree {
+        // the default reciprocity averaging needs the whole grid, which -t4 7 does not hold
+        if fenestra_genbsdf::tree4::streams(rank, l) && recip && !recip_given {
+            fenestra_cli::warn(format!(
+                "-t4 {l}: reflection not averaged with its reciprocal (+a needs the whole grid in memory)"
+            ));
+            recip = false;
+        }
+    }
     let sides = u64::from(o.forward) + u64::from(o.backward);
     let ndir = match tree {
-        Some((4, l)) => (1u64 << (2 * l)) * sides,
+        // a streamed reduction traces every incident cell twice
+        Some((4, l)) => {
+            (1u64 << (2 * l))
+                * sides
+                * if fenestra_genbsdf::tree4::streams(4, l) {
+                    2
+                } else {
+                    1
+                }
+        }
         Some((_, l)) => (1u64 << (l - 1)) * sides,
         None => fenestra_genbsdf::directions(&o),
     };
@@ -272,6 +294,9 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             r.indirect,
             r.specular
         );
+        if let Some(kb) = fenestra_cli::peak_rss_kb() {
+            eprintln!("{p}: peak resident memory {:.1} MB", kb as f64 / 1024.0);
+        }
     }
     Ok(ExitCode::SUCCESS)
 }

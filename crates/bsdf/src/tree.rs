@@ -108,6 +108,14 @@ pub struct TreeError {
 impl TensorTree {
     /// The tree as `ScatteringData` text (values in their shortest exact form).
     pub fn to_text(&self) -> String {
+        let mut out = String::new();
+        self.write_text(&mut out);
+        out
+    }
+
+    /// [`TensorTree::to_text`] appended to `out` (no copy of a large tree's text).
+    pub fn write_text(&self, out: &mut String) {
+        use std::fmt::Write as _;
         fn node(out: &mut String, n: &Node, depth: usize) {
             for _ in 0..depth {
                 out.push_str("    ");
@@ -116,8 +124,7 @@ impl TensorTree {
                 Node::Grid { values, .. } => {
                     out.push('{');
                     for v in values {
-                        out.push(' ');
-                        out.push_str(&format!("{v:e}"));
+                        let _ = write!(out, " {v:e}");
                     }
                     out.push_str(" }\n");
                 }
@@ -133,9 +140,7 @@ impl TensorTree {
                 }
             }
         }
-        let mut out = String::new();
-        node(&mut out, &self.root, 0);
-        out
+        node(out, &self.root, 0);
     }
 
     /// Parses `ScatteringData` text of a tree of the given rank (3 or 4).

@@ -103,7 +103,7 @@ pub fn klems_xml(b: &Bsdf, comment: Option<&str>) -> Result<String, WriteError> 
             };
             let _ = write!(
                 out,
-                "\t<WavelengthData>\n\t\t<LayerNumber>System</LayerNumber>\n\t\t<Wavelength unit=\"Integral\">{}</Wavelength>\n\t\t<SourceSpectrum>CIE Illuminant D65 1nm.ssp</SourceSpectrum>\n{}\t\t<WavelengthDataBlock>\n\t\t\t<WavelengthDataDirection>{}</WavelengthDataDirection>\n\t\t\t<AngleBasis>LBNL/Shirley-Chiu</AngleBasis>\n\t\t\t<ScatteringDataType>{}</ScatteringDataType>\n\t\t\t<ScatteringData>\n{}",
+                "\t<WavelengthData>\n\t\t<LayerNumber>System</LayerNumber>\n\t\t<Wavelength unit=\"Integral\">{}</Wavelength>\n\t\t<SourceSpectrum>CIE Illuminant D65 1nm.ssp</SourceSpectrum>\n{}\t\t<WavelengthDataBlock>\n\t\t\t<WavelengthDataDirection>{}</WavelengthDataDirection>\n\t\t\t<AngleBasis>LBNL/Shirley-Chiu</AngleBasis>\n\t\t\t<ScatteringDataType>{}</ScatteringDataType>\n\t\t\t<ScatteringData>\n",
                 escape(blk.wavelength.xml_name()),
                 // wrapBSDF writes no detector for the u′ and v′ trees
                 match blk.wavelength {
@@ -114,8 +114,8 @@ pub fn klems_xml(b: &Bsdf, comment: Option<&str>) -> Result<String, WriteError> 
                 },
                 blk.direction.xml_name(),
                 if blk.data_type.is_empty() { "BTDF" } else { &blk.data_type },
-                t.to_text()
             );
+            t.write_text(&mut out);
             out.push_str(
                 "\t\t\t</ScatteringData>\n\t\t</WavelengthDataBlock>\n\t</WavelengthData>\n",
             );

@@ -14,6 +14,7 @@ pub mod raypath;
 pub mod rays;
 mod run;
 pub mod threads;
+pub use threads::peak_rss_kb;
 
 pub use run::{
     command_line, main_with, main_with_args, prog, set_prog, set_warnings, warn, warnings_on, Exit,

@@ -32,6 +32,16 @@ pub fn worker_count(n: f64) -> Result<usize> {
     Ok(n as usize)
 }
 
+/// Peak resident memory of this process in kilobytes (Linux `VmHWM`); `None` where the
+/// system does not say.
+pub fn peak_rss_kb() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmHWM:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
+}
+
 #[cfg(test)]
 mod tests {
     #[test]

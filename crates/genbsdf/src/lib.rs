@@ -18,6 +18,7 @@ pub mod geometry;
 mod summary;
 pub use summary::summary;
 pub mod reduce;
+pub mod reduce_stream;
 pub mod tree4;
 
 use anyhow::{bail, Result};
@@ -67,6 +68,9 @@ pub struct Options {
     /// The Klems basis (`-k kf|kh|kq`, fenestra): full (145 patches, Radiance's genBSDF's
     /// only one), half (77) or quarter (41).
     pub basis: &'static KlemsBasis,
+    /// Rank-4 trees: reduce without the whole grid in memory, tracing every incident cell
+    /// twice (`tree4::streams`: on by itself from `-t4 7`; forced here for tests).
+    pub stream_trees: bool,
 }
 
 impl Options {
@@ -86,6 +90,7 @@ impl Options {
             colour: false,
             checkpoint: None,
             basis: KlemsBasis::full(),
+            stream_trees: false,
         }
     }
 }

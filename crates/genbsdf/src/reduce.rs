@@ -9,9 +9,9 @@
 use std::fmt::Write as _;
 
 /// Histogram bins of the variability measure.
-const HISTLEN: usize = 300;
+pub(crate) const HISTLEN: usize = 300;
 /// Largest measure recorded.
-const HISTMAX: f64 = 4.0;
+pub(crate) const HISTMAX: f64 = 4.0;
 
 struct TNode {
     vmin: f32,
@@ -21,7 +21,29 @@ struct TNode {
 }
 
 fn measure(n: &TNode) -> f64 {
-    (f64::from(n.vmax - n.vmin) / (f64::from(n.vavg).sqrt() + 0.03)).sqrt()
+    variability(n.vmin, n.vmax, n.vavg)
+}
+
+/// rttree_reduce's variability of a node from its minimum, maximum and mean.
+pub(crate) fn variability(vmin: f32, vmax: f32, vavg: f32) -> f64 {
+    (f64::from(vmax - vmin) / (f64::from(vavg).sqrt() + 0.03)).sqrt()
+}
+
+/// The histogram bin of a variability.
+pub(crate) fn bin(m: f64) -> usize {
+    (((HISTLEN as f64 / HISTMAX) * m) as usize).min(HISTLEN - 1)
+}
+
+/// The merge threshold: the `pctcull` percentile of the lowest branch nodes' variability.
+pub(crate) fn threshold(histo: &[usize], pctcull: f64) -> f64 {
+    let total: usize = histo.iter().sum();
+    let mut hsum = (pctcull * 0.01 * total as f64) as i64;
+    let mut i = 0;
+    while hsum > 0 && i < histo.len() {
+        hsum -= histo[i] as i64;
+        i += 1;
+    }
+    (HISTMAX / HISTLEN as f64) * i as f64
 }
 
 /// The data of one component on a `2^log2` grid per dimension, dimension 0 slowest
@@ -76,8 +98,7 @@ impl Builder<'_> {
                 n.vavg += v;
             }
             n.vavg /= (1usize << rank) as f32;
-            let k = ((HISTLEN as f64 / HISTMAX) * measure(&n)) as usize;
-            self.histo[k.min(HISTLEN - 1)] += 1;
+            self.histo[bin(measure(&n))] += 1;
             return n;
         }
         let l2s = l2s - 1;
@@ -115,7 +136,7 @@ fn trim(n: &mut TNode, thresh: f64) {
     n.kids = None;
 }
 
-fn fmt_value(v: f32) -> String {
+pub(crate) fn fmt_value(v: f32) -> String {
     if (0.001..10.0).contains(&v) {
         format!(" {v:.7}")
     } else {
@@ -207,14 +228,7 @@ pub fn reduce(grid: &Grid, pctcull: f64) -> String {
         histo: vec![0; HISTLEN],
     };
     let mut root = b.build([0; 4], grid.log2);
-    let total: usize = b.histo.iter().sum();
-    let mut hsum = (pctcull * 0.01 * total as f64) as i64;
-    let mut i = 0;
-    while hsum > 0 {
-        hsum -= b.histo[i] as i64;
-        i += 1;
-    }
-    let thresh = (HISTMAX / HISTLEN as f64) * i as f64;
+    let thresh = threshold(&b.histo, pctcull);
     trim(&mut root, thresh);
     let mut out = String::new();
     print(&mut out, grid, &root, [0; 4], grid.log2, thresh);

@@ -7,7 +7,7 @@
 //! the concentric map to the disk point (dx, dy), and the direction of travel is
 //! (dx, dy, ±√(1 − dx² − dy²)), both for the incident rays and for the outgoing ones.
 
-use anyhow::Result;
+use anyhow::{bail, Result};
 use fenestra_bsdf::tree::{disk_to_square, square_to_disk, TensorTree};
 use fenestra_bsdf::{Block, BlockData, Bsdf, DataStructure, Wavelength};
 use fenestra_scene::Scene;
@@ -16,6 +16,7 @@ use fenestra_trace::DVec3;
 use rayon::prelude::*;
 
 use crate::reduce::{reciprocity, reduce, Grid};
+use crate::reduce_stream::{Rows, StreamReduce};
 use crate::{
     direction_strata, grid, plane_point, sample_seed, setup, sides, Characterised, Options, Setup,
 };
@@ -27,13 +28,92 @@ fn cell_of(d: DVec3, n: usize) -> usize {
     c(sx) * n + c(sy)
 }
 
-/// One value per (incident row, outgoing cell), single precision, in grid order.
-fn cell_values(rows: &[Vec<f64>], ncell: usize, f: impl Fn(&[f64], usize) -> f64) -> Vec<f32> {
-    let mut out = Vec::with_capacity(rows.len() * ncell);
-    for r in rows {
-        out.extend((0..ncell).map(|o| f(r, o) as f32));
+/// One incident cell's sums: transmission and reflection (Y, then X and Z with `+C`, per
+/// outgoing cell) and with `-E` the per-sample squares (transmission then reflection).
+type CellSums = (Vec<f64>, Vec<f64>, Vec<f64>);
+
+/// log2 of the side of the blocks of incident cells a streamed reduction traces at once
+/// (64 cells: a few tens of megabytes at L = 7).
+const STREAM_BATCH_LOG2: u32 = 3;
+
+/// Rank-4 trees from this resolution up are reduced without the whole grid in memory
+/// (`reduce_stream`: every incident cell traced twice).
+pub const STREAM_FROM_LOG2: u32 = 7;
+
+/// Whether a run streams its reduction (and so traces every incident cell twice).
+pub fn streams(rank: usize, log2: u32) -> bool {
+    rank == 4 && log2 >= STREAM_FROM_LOG2
+}
+
+/// What a grid holds.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Kind {
+    /// Y / (π/N²): the BSDF.
+    Y,
+    /// genBSDF's CIE u′ of each cell (4/19 where nothing arrives).
+    U,
+    /// CIE v′ (9/19 where nothing arrives).
+    V,
+    /// The standard error of the Y value (`-E`).
+    Error,
+}
+
+/// One grid of a side: its block's direction, component and culling percentile.
+struct Spec {
+    dir: fenestra_bsdf::Direction,
+    is_trans: bool,
+    kind: Kind,
+    pct: f64,
+}
+
+/// Turns an incident cell's sums into one grid row.
+struct Convert {
+    ncell: usize,
+    ns: usize,
+    omega: f64,
+}
+
+impl Convert {
+    fn row(&self, r: &CellSums, sp: &Spec) -> Vec<f32> {
+        let ncell = self.ncell;
+        let sums = if sp.is_trans { &r.0 } else { &r.1 };
+        let nf = self.ns as f64;
+        match sp.kind {
+            Kind::Y => {
+                let scale = 1.0 / nf / self.omega;
+                sums[..ncell].iter().map(|v| (v * scale) as f32).collect()
+            }
+            Kind::U | Kind::V => (0..ncell)
+                .map(|o| {
+                    let (x, y, z) = (sums[ncell + o], sums[o], sums[2 * ncell + o]);
+                    let den = x + 15.0 * y + 3.0 * z;
+                    (match (y != 0.0, sp.kind == Kind::U) {
+                        (true, true) => 4.0 * x / den,
+                        (true, false) => 9.0 * y / den,
+                        (false, true) => 4.0 / 19.0,
+                        (false, false) => 9.0 / 19.0,
+                    }) as f32
+                })
+                .collect(),
+            Kind::Error => {
+                // from the spread of the samples' totals
+                let base = if sp.is_trans { 0 } else { ncell };
+                sums[..ncell]
+                    .iter()
+                    .zip(&r.2[base..base + ncell])
+                    .map(|(s, q)| {
+                        let se = if self.ns > 1 {
+                            let var = ((q - s * s / nf) / (nf - 1.0)).max(0.0);
+                            (var / nf).sqrt() / self.omega
+                        } else {
+                            0.0
+                        };
+                        se as f32
+                    })
+                    .collect()
+            }
+        }
     }
-    out
 }
 
 /// Characterises the device as tensor trees of rank `rank` (3 or 4) and resolution 2^`log2`.
@@ -66,6 +146,13 @@ pub fn characterise(
     let (nx, ny) = grid(opts.samples.max(1), w, h);
     let ns = nx * ny;
     let omega = std::f64::consts::PI / ncell as f64;
+    let stream = rank == 4 && (streams(rank, log2) || opts.stream_trees);
+    if stream && recip {
+        bail!("+a: reciprocity averaging pairs cells across the whole grid, which -t4 {log2} does not hold in memory (use -a)");
+    }
+    if stream && opts.checkpoint.is_some() {
+        bail!("-checkpoint: not available with -t4 {log2} (its reduction traces every incident cell twice)");
+    }
     let ckpt = match &opts.checkpoint {
         Some(path) => {
             let parts = format!(
@@ -91,196 +178,195 @@ pub fn characterise(
     let mut error_blocks = Vec::new();
     for (side_k, &(from_room, tdir, rdir)) in sides(opts).iter().enumerate() {
         let z = if from_room { z1 + 1e-6 } else { z0 - 1e-6 };
-        // per incident cell: Y (then X, Z) flux toward the far side (transmission) and back
-        // (reflection), channel-major
-        // per incident cell: (transmission, reflection), and with -E each outgoing cell's sum
-        // of squared per-sample Y totals (transmission then reflection, 2 × ncell)
-        let rows: Vec<(Vec<f64>, Vec<f64>, Vec<f64>)> = pool.install(|| {
-            (0..nin)
-                .into_par_iter()
-                .map(|cell| {
-                    if let Some([t, r, q, _]) = ckpt.as_ref().and_then(|c| c.get(side_k, cell)) {
-                        done();
-                        return (t.clone(), r.clone(), q.clone());
+        // one incident cell: Y (then X, Z) flux toward the far side (transmission) and back
+        // (reflection), channel-major, and with -E each outgoing cell's sum of squared
+        // per-sample Y totals (transmission then reflection, 2 × ncell)
+        let trace_cell = |cell: usize| -> CellSums {
+            let (ix, iy) = (cell / n, cell % n);
+            let mut trans = vec![0.0; nch * ncell];
+            let mut refl = vec![0.0; nch * ncell];
+            let mut sq = vec![0.0; if opts.errors { 2 * ncell } else { 0 }];
+            let mut hits: Vec<(usize, f64)> = Vec::new();
+            let strata = direction_strata(seed, (side_k * nin + cell) as u64, ns);
+            for (k, &stratum) in strata.iter().enumerate() {
+                hits.clear();
+                let index = ((side_k * nin + cell) * ns + k) as u64;
+                let mut rng = Rng::for_ray(seed, index);
+                let (px, py) = plane_point(&mut rng, k, (nx, ny), x0, y0, w, h);
+                let t = (f64::from(stratum) + rng.next_f64()) / ns as f64;
+                let (s1, s2) = spread2(t, &mut rng);
+                let (dx, dy) = if rank == 4 {
+                    square_to_disk((ix as f64 + s1) / n as f64, (iy as f64 + s2) / n as f64)
+                } else {
+                    // genBSDF's isotropic rays: sinθ uniform within the cell, the
+                    // azimuth at 0 give or take a sliver alternating with the cell
+                    let dx = 1.0 - 2.0 * (cell as f64 + s1) / n as f64;
+                    let side = if cell % 2 == 1 { -1.0 } else { 1.0 };
+                    let dy = (1.0 / n as f64).min((1.0 - dx * dx).max(0.0).sqrt()) * side * s2;
+                    (dx, dy)
+                };
+                let dz = (1.0 - dx * dx - dy * dy).max(0.0).sqrt();
+                let dir = DVec3::new(dx, dy, if from_room { -dz } else { dz });
+                let org = DVec3::new(px, py, z);
+                tracer.contributions(index, org, dir, &tracked, &mut |c| {
+                    let dot =
+                        |w: [f64; 3]| -> f64 { c.coef.iter().zip(w).map(|(a, w)| a * w).sum() };
+                    let d = c.dir;
+                    let o = cell_of(d, n);
+                    // transmission: on past the device (toward the room for light
+                    // from outside, away from it for light from the room)
+                    let is_t = (d.z > 0.0) != from_room;
+                    let to = if is_t { &mut trans } else { &mut refl };
+                    let y = dot(y_w);
+                    to[o] += y;
+                    if opts.errors {
+                        hits.push((if is_t { o } else { ncell + o }, y));
                     }
-                    let (ix, iy) = (cell / n, cell % n);
-                    let mut trans = vec![0.0; nch * ncell];
-                    let mut refl = vec![0.0; nch * ncell];
-                    let mut sq = vec![0.0; if opts.errors { 2 * ncell } else { 0 }];
-                    let mut hits: Vec<(usize, f64)> = Vec::new();
-                    let strata = direction_strata(seed, (side_k * nin + cell) as u64, ns);
-                    for (k, &stratum) in strata.iter().enumerate() {
-                        hits.clear();
-                        let index = ((side_k * nin + cell) * ns + k) as u64;
-                        let mut rng = Rng::for_ray(seed, index);
-                        let (px, py) = plane_point(&mut rng, k, (nx, ny), x0, y0, w, h);
-                        let t = (f64::from(stratum) + rng.next_f64()) / ns as f64;
-                        let (s1, s2) = spread2(t, &mut rng);
-                        let (dx, dy) = if rank == 4 {
-                            square_to_disk((ix as f64 + s1) / n as f64, (iy as f64 + s2) / n as f64)
-                        } else {
-                            // genBSDF's isotropic rays: sinθ uniform within the cell, the
-                            // azimuth at 0 give or take a sliver alternating with the cell
-                            let dx = 1.0 - 2.0 * (cell as f64 + s1) / n as f64;
-                            let side = if cell % 2 == 1 { -1.0 } else { 1.0 };
-                            let dy =
-                                (1.0 / n as f64).min((1.0 - dx * dx).max(0.0).sqrt()) * side * s2;
-                            (dx, dy)
-                        };
-                        let dz = (1.0 - dx * dx - dy * dy).max(0.0).sqrt();
-                        let dir = DVec3::new(dx, dy, if from_room { -dz } else { dz });
-                        let org = DVec3::new(px, py, z);
-                        tracer.contributions(index, org, dir, &tracked, &mut |c| {
-                            let dot = |w: [f64; 3]| -> f64 {
-                                c.coef.iter().zip(w).map(|(a, w)| a * w).sum()
-                            };
-                            let d = c.dir;
-                            let o = cell_of(d, n);
-                            // transmission: on past the device (toward the room for light
-                            // from outside, away from it for light from the room)
-                            let is_t = (d.z > 0.0) != from_room;
-                            let to = if is_t { &mut trans } else { &mut refl };
-                            let y = dot(y_w);
-                            to[o] += y;
-                            if opts.errors {
-                                hits.push((if is_t { o } else { ncell + o }, y));
-                            }
-                            if nch == 3 {
-                                to[ncell + o] += dot(x_w);
-                                to[2 * ncell + o] += dot(z_w);
-                            }
-                        });
-                        if opts.errors {
-                            // one sample's total per cell, then its square
-                            hits.sort_unstable_by_key(|h| h.0);
-                            let mut j = 0;
-                            while j < hits.len() {
-                                let (slot, mut v) = hits[j];
-                                j += 1;
-                                while j < hits.len() && hits[j].0 == slot {
-                                    v += hits[j].1;
-                                    j += 1;
-                                }
-                                sq[slot] += v * v;
-                            }
+                    if nch == 3 {
+                        to[ncell + o] += dot(x_w);
+                        to[2 * ncell + o] += dot(z_w);
+                    }
+                });
+                if opts.errors {
+                    // one sample's total per cell, then its square
+                    hits.sort_unstable_by_key(|h| h.0);
+                    let mut j = 0;
+                    while j < hits.len() {
+                        let (slot, mut v) = hits[j];
+                        j += 1;
+                        while j < hits.len() && hits[j].0 == slot {
+                            v += hits[j].1;
+                            j += 1;
                         }
+                        sq[slot] += v * v;
                     }
-                    done();
-                    if let Some(c) = &ckpt {
-                        let all = [trans.clone(), refl.clone(), sq.clone(), Vec::new()];
-                        if let Err(e) = c.put(side_k, cell, &all) {
-                            fail.lock()
-                                .unwrap_or_else(|e| e.into_inner())
-                                .get_or_insert(e);
-                        }
-                    }
-                    (trans, refl, sq)
-                })
-                .collect()
-        });
-        if let Some(e) = fail.lock().unwrap_or_else(|e| e.into_inner()).take() {
-            return Err(e);
-        }
-        let scale = 1.0 / ns as f64 / omega;
+                }
+            }
+            (trans, refl, sq)
+        };
+        // the grids written for this side, in the file's block order
+        let mut specs = Vec::new();
         for (dir, is_trans) in [(tdir, true), (rdir, false)] {
             if opts.errors {
-                // the standard error of each cell's value, from the spread of the samples'
-                // totals, before reciprocity averaging (with +a an upper bound), reduced as the
-                // values are
-                let nf = ns as f64;
-                let base = if is_trans { 0 } else { ncell };
-                let mut data: Vec<f32> = Vec::with_capacity(nin * ncell);
-                for r in &rows {
-                    let sums = if is_trans { &r.0 } else { &r.1 };
-                    for (s, q) in sums[..ncell].iter().zip(&r.2[base..base + ncell]) {
-                        let se = if ns > 1 {
-                            let var = ((q - s * s / nf) / (nf - 1.0)).max(0.0);
-                            (var / nf).sqrt() / omega
-                        } else {
-                            0.0
-                        };
-                        data.push(se as f32);
-                    }
-                }
-                data.resize(n.pow(rank as u32), 0.0);
-                let text = reduce(
-                    &Grid {
-                        rank,
-                        log2,
-                        data: &data,
-                    },
-                    pctcull,
-                );
-                let tree = TensorTree::parse(rank, &text)
-                    .map_err(|e| anyhow::anyhow!("internal: reduced tree does not parse: {e:?}"))?;
-                error_blocks.push(Block {
-                    wavelength: Wavelength::Visible,
-                    direction: dir,
-                    data_type: "BTDF".into(),
-                    data: BlockData::Tree(tree),
+                specs.push(Spec {
+                    dir,
+                    is_trans,
+                    kind: Kind::Error,
+                    pct: pctcull,
                 });
             }
-            let comp = |r: &(Vec<f64>, Vec<f64>, Vec<f64>)| -> Vec<f64> {
-                if is_trans {
-                    r.0.clone()
-                } else {
-                    r.1.clone()
-                }
-            };
-            let rows_c: Vec<Vec<f64>> = rows.iter().map(comp).collect();
-            // Y / (π/N²); with +C also genBSDF's u′ and v′ of each cell (4/19 and 9/19
-            // where nothing arrives), culled at 100 − (100 − pct)/4
-            let mut trees = vec![(
-                Wavelength::Visible,
-                pctcull,
-                cell_values(&rows_c, ncell, |v, o| v[o] * scale),
-            )];
+            specs.push(Spec {
+                dir,
+                is_trans,
+                kind: Kind::Y,
+                pct: pctcull,
+            });
             if opts.colour {
-                let uv = |v: &[f64], o: usize, u: bool| {
-                    let (x, y, z) = (v[ncell + o], v[o], v[2 * ncell + o]);
-                    let den = x + 15.0 * y + 3.0 * z;
-                    match (y != 0.0, u) {
-                        (true, true) => 4.0 * x / den,
-                        (true, false) => 9.0 * y / den,
-                        (false, true) => 4.0 / 19.0,
-                        (false, false) => 9.0 / 19.0,
-                    }
-                };
                 let pct_uv = 100.0 - (100.0 - pctcull) * 0.25;
-                trees.push((
-                    Wavelength::CieU,
-                    pct_uv,
-                    cell_values(&rows_c, ncell, |v, o| uv(v, o, true)),
-                ));
-                trees.push((
-                    Wavelength::CieV,
-                    pct_uv,
-                    cell_values(&rows_c, ncell, |v, o| uv(v, o, false)),
-                ));
-            }
-            for (wavelength, pct, mut data) in trees {
-                // a rank-3 grid's upper half of incident cells stays empty (as
-                // rttree_reduce fills it with zeros)
-                data.resize(n.pow(rank as u32), 0.0);
-                if recip && (rank == 3 || !is_trans) {
-                    reciprocity(rank, log2, &mut data);
-                }
-                let text = reduce(
-                    &Grid {
-                        rank,
-                        log2,
-                        data: &data,
-                    },
-                    pct,
-                );
-                let tree = TensorTree::parse(rank, &text)
-                    .map_err(|e| anyhow::anyhow!("internal: reduced tree does not parse: {e:?}"))?;
-                blocks.push(Block {
-                    wavelength,
-                    direction: dir,
-                    data_type: "BTDF".into(),
-                    data: BlockData::Tree(tree),
+                specs.push(Spec {
+                    dir,
+                    is_trans,
+                    kind: Kind::U,
+                    pct: pct_uv,
                 });
+                specs.push(Spec {
+                    dir,
+                    is_trans,
+                    kind: Kind::V,
+                    pct: pct_uv,
+                });
+            }
+        }
+        let conv = Convert { ncell, ns, omega };
+        let texts: Vec<String> = if stream {
+            // a block of incident cells at a time, traced again in the second pass
+            let rows = |x0: usize, y0: usize, side: usize| -> Result<Rows> {
+                let cells: Vec<usize> = (x0..x0 + side)
+                    .flat_map(|ix| (y0..y0 + side).map(move |iy| ix * n + iy))
+                    .collect();
+                Ok(pool.install(|| {
+                    cells
+                        .par_iter()
+                        .map(|&cell| {
+                            let r = trace_cell(cell);
+                            done();
+                            specs.iter().map(|sp| conv.row(&r, sp)).collect()
+                        })
+                        .collect()
+                }))
+            };
+            let pcts: Vec<f64> = specs.iter().map(|sp| sp.pct).collect();
+            let reducer = StreamReduce::new(log2, STREAM_BATCH_LOG2, specs.len(), &rows);
+            pool.install(|| reducer.reduce(&pcts))?
+        } else {
+            let rows: Vec<CellSums> = pool.install(|| {
+                (0..nin)
+                    .into_par_iter()
+                    .map(|cell| {
+                        if let Some([t, r, q, _]) = ckpt.as_ref().and_then(|c| c.get(side_k, cell))
+                        {
+                            done();
+                            return (t.clone(), r.clone(), q.clone());
+                        }
+                        let (trans, refl, sq) = trace_cell(cell);
+                        done();
+                        if let Some(c) = &ckpt {
+                            let all = [trans.clone(), refl.clone(), sq.clone(), Vec::new()];
+                            if let Err(e) = c.put(side_k, cell, &all) {
+                                fail.lock()
+                                    .unwrap_or_else(|e| e.into_inner())
+                                    .get_or_insert(e);
+                            }
+                        }
+                        (trans, refl, sq)
+                    })
+                    .collect()
+            });
+            if let Some(e) = fail.lock().unwrap_or_else(|e| e.into_inner()).take() {
+                return Err(e);
+            }
+            specs
+                .iter()
+                .map(|sp| {
+                    let mut data: Vec<f32> = Vec::with_capacity(n.pow(rank as u32));
+                    for r in &rows {
+                        data.extend(conv.row(r, sp));
+                    }
+                    // a rank-3 grid's upper half of incident cells stays empty (as
+                    // rttree_reduce fills it with zeros)
+                    data.resize(n.pow(rank as u32), 0.0);
+                    // the errors are before reciprocity averaging (with +a an upper bound)
+                    if recip && sp.kind != Kind::Error && (rank == 3 || !sp.is_trans) {
+                        reciprocity(rank, log2, &mut data);
+                    }
+                    reduce(
+                        &Grid {
+                            rank,
+                            log2,
+                            data: &data,
+                        },
+                        sp.pct,
+                    )
+                })
+                .collect()
+        };
+        for (sp, text) in specs.iter().zip(texts) {
+            let tree = TensorTree::parse(rank, &text)
+                .map_err(|e| anyhow::anyhow!("internal: reduced tree does not parse: {e:?}"))?;
+            let block = Block {
+                wavelength: match sp.kind {
+                    Kind::Y | Kind::Error => Wavelength::Visible,
+                    Kind::U => Wavelength::CieU,
+                    Kind::V => Wavelength::CieV,
+                },
+                direction: sp.dir,
+                data_type: "BTDF".into(),
+                data: BlockData::Tree(tree),
+            };
+            if sp.kind == Kind::Error {
+                error_blocks.push(block);
+            } else {
+                blocks.push(block);
             }
         }
     }
