@@ -145,13 +145,9 @@ fn oracle_tree_windows_agree_within_noise() {
     }
 }
 
-/// Without jitter and ambient light the direct sun through a tree is deterministic in both
-/// tools: 80 view rays through the window within 1e-4 (printed digits, Radiance's single
-/// precision leaves).
-#[test]
-fn oracle_tree_direct_exact() {
-    let Some(o) = common::oracle() else { return };
-    let dir = office("bsdf-tree-exact", "blinds_t4.xml");
+/// The direct sun through the office's window along 80 view directions from inside, no
+/// jitter and no ambient light (deterministic in both tools): the oracle's RGB and ours.
+fn direct_views(o: &common::Oracle, dir: &Path) -> (Vec<f64>, Vec<f64>) {
     let mut rays = String::new();
     for th in (0..80).step_by(8) {
         for ph in (0..360).step_by(45) {
@@ -168,19 +164,30 @@ fn oracle_tree_direct_exact() {
         "sun.rad",
     ];
     let mut c = o.command("oconv");
-    c.args(scene).current_dir(&dir);
+    c.args(scene).current_dir(dir);
     std::fs::write(dir.join("scene.oct"), common::run_ok(&mut c)).unwrap();
     let mut c = o.command("rtrace");
     c.args(["-h", "-aa", "0", "-ab", "0", "-ss", "0", "scene.oct"])
-        .current_dir(&dir);
+        .current_dir(dir);
     let theirs = numbers(&run_stdin(c, rays.as_bytes()).stdout);
     let mut c = fenestra("rtrace");
     c.args(["-h", "-ab", "0", "-ss", "0"])
         .args(scene)
-        .current_dir(&dir);
-    c.env("RAYPATH", &dir);
+        .current_dir(dir);
+    c.env("RAYPATH", dir);
     let ours = numbers(&run_stdin(c, rays.as_bytes()).stdout);
     assert_eq!(theirs.len(), ours.len());
+    (theirs, ours)
+}
+
+/// Without jitter and ambient light the direct sun through a tree is deterministic in both
+/// tools: 80 view rays through the window within 1e-4 (printed digits, Radiance's single
+/// precision leaves).
+#[test]
+fn oracle_tree_direct_exact() {
+    let Some(o) = common::oracle() else { return };
+    let dir = office("bsdf-tree-exact", "blinds_t4.xml");
+    let (theirs, ours) = direct_views(&o, &dir);
     let lum = |v: &[f64]| -> Vec<f64> {
         v.chunks(3)
             .map(|c| 0.265 * c[0] + 0.670 * c[1] + 0.065 * c[2])
@@ -202,16 +209,7 @@ fn oracle_tree_direct_exact() {
 fn oracle_coloured_tree_renders_in_colour() {
     let Some(o) = common::oracle() else { return };
     let dir = office("bsdf-tree-colour", "blinds_t4.xml");
-    let mut slats = String::from("void plastic redslat 0 0 5 0.7 0.25 0.1 0 0\n");
-    for k in 0..6 {
-        let (yc, a) = (0.025 + 0.05 * k as f64, 30f64.to_radians());
-        let (dy, dz) = (0.0225 * a.sin(), 0.0225 * a.cos());
-        slats.push_str(&format!(
-            "redslat polygon slat{k} 0 0 12 0 {:.5} {:.5} 0.3 {:.5} {:.5} 0.3 {:.5} {:.5} 0 {:.5} {:.5}\n",
-            yc - dy, -0.02 - dz, yc - dy, -0.02 - dz, yc + dy, -0.02 + dz, yc + dy, -0.02 + dz
-        ));
-    }
-    std::fs::write(dir.join("red.rad"), slats).unwrap();
+    std::fs::write(dir.join("red.rad"), common::red_slats()).unwrap();
     let mut g = fenestra("genBSDF");
     g.args([
         "-q", "-n", "2", "-t4", "3", "-c", "100", "+C", "+f", "+b", "-geom", "meter", "red.rad",
@@ -224,35 +222,7 @@ fn oracle_coloured_tree_renders_in_colour() {
         .unwrap()
         .replace("blinds_t4.xml", "red_t4.xml");
     std::fs::write(dir.join("window.rad"), win).unwrap();
-    let mut rays = String::new();
-    for th in (0..80).step_by(8) {
-        for ph in (0..360).step_by(45) {
-            let (t, p) = (f64::from(th).to_radians(), f64::from(ph).to_radians());
-            let d = [t.sin() * p.cos(), -t.cos(), t.sin() * p.sin()];
-            rays.push_str(&format!("2 1.0 1.65 {:.6} {:.6} {:.6}\n", d[0], d[1], d[2]));
-        }
-    }
-    let scene = [
-        "materials.rad",
-        "room.rad",
-        "exterior.rad",
-        "window.rad",
-        "sun.rad",
-    ];
-    let mut c = o.command("oconv");
-    c.args(scene).current_dir(&dir);
-    std::fs::write(dir.join("scene.oct"), common::run_ok(&mut c)).unwrap();
-    let mut c = o.command("rtrace");
-    c.args(["-h", "-aa", "0", "-ab", "0", "-ss", "0", "scene.oct"])
-        .current_dir(&dir);
-    let theirs = numbers(&run_stdin(c, rays.as_bytes()).stdout);
-    let mut c = fenestra("rtrace");
-    c.args(["-h", "-ab", "0", "-ss", "0"])
-        .args(scene)
-        .current_dir(&dir);
-    c.env("RAYPATH", &dir);
-    let ours = numbers(&run_stdin(c, rays.as_bytes()).stdout);
-    assert_eq!(theirs.len(), ours.len());
+    let (theirs, ours) = direct_views(&o, &dir);
     let lit: Vec<usize> = (0..theirs.len() / 3)
         .filter(|&k| theirs[3 * k] > 0.0)
         .collect();

@@ -1015,33 +1015,12 @@ fn half_and_quarter_klems_bases() {
     }
 }
 
-/// Red plastic slats (6, tilted 30°) over a 0.3 m square sample, in genBSDF's frame.
-fn red_slats() -> String {
-    let mut s = String::from("void plastic redslat 0 0 5 0.7 0.25 0.1 0 0\n");
-    for k in 0..6 {
-        let (yc, a) = (0.025 + 0.05 * k as f64, 30f64.to_radians());
-        let (dy, dz) = (0.0225 * a.sin(), 0.0225 * a.cos());
-        s.push_str(&format!(
-            "redslat polygon slat{k} 0 0 12 0 {:.5} {:.5} 0.3 {:.5} {:.5} 0.3 {:.5} {:.5} 0 {:.5} {:.5}\n",
-            yc - dy,
-            -0.02 - dz,
-            yc - dy,
-            -0.02 - dz,
-            yc + dy,
-            -0.02 + dz,
-            yc + dy,
-            -0.02 + dz
-        ));
-    }
-    s
-}
-
 /// The streamed reduction (the one `-t4 7` uses: the grid never held, every incident cell
 /// traced twice) writes the same files as the in-memory one, colour and standard errors
 /// included, at L = 3 and 4.
 #[test]
 fn streamed_tree_reduction_writes_the_same_files() {
-    let scene = fenestra_scene::parse_str(&red_slats(), "red.rad").unwrap();
+    let scene = fenestra_scene::parse_str(&common::red_slats(), "red.rad").unwrap();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(2)
         .build()

@@ -258,3 +258,24 @@ pub fn fails_with(scratch_name: &str, scene: &str, want: &[&str]) {
         assert!(err.contains(w), "missing '{w}' in: {err}");
     }
 }
+
+/// Red plastic slats (6, tilted 30°) over a 0.3 m square sample, in genBSDF's frame.
+pub fn red_slats() -> String {
+    let mut s = String::from("void plastic redslat 0 0 5 0.7 0.25 0.1 0 0\n");
+    for k in 0..6 {
+        let (yc, a) = (0.025 + 0.05 * k as f64, 30f64.to_radians());
+        let (dy, dz) = (0.0225 * a.sin(), 0.0225 * a.cos());
+        s.push_str(&format!(
+            "redslat polygon slat{k} 0 0 12 0 {:.5} {:.5} 0.3 {:.5} {:.5} 0.3 {:.5} {:.5} 0 {:.5} {:.5}\n",
+            yc - dy,
+            -0.02 - dz,
+            yc - dy,
+            -0.02 - dz,
+            yc + dy,
+            -0.02 + dz,
+            yc + dy,
+            -0.02 + dz
+        ));
+    }
+    s
+}
