@@ -225,6 +225,22 @@ pub(crate) fn plane_point(
     )
 }
 
+/// Adds one sample's squared total per slot to `sq` (for standard errors): the sample's
+/// contributions `hits` (slot, value) summed per slot first (sorted in place).
+pub(crate) fn add_squares(hits: &mut [(usize, f64)], sq: &mut [f64]) {
+    hits.sort_unstable_by_key(|h| h.0);
+    let mut j = 0;
+    while j < hits.len() {
+        let (slot, mut v) = hits[j];
+        j += 1;
+        while j < hits.len() && hits[j].0 == slot {
+            v += hits[j].1;
+            j += 1;
+        }
+        sq[slot] += v * v;
+    }
+}
+
 /// The seed of the sample plane and directions: `base`, changed by the render options'
 /// `-seed` (`-r '-seed N'`), so runs with different seeds are independent replicates.
 pub(crate) fn sample_seed(base: u64, opts: &Options) -> u64 {
@@ -396,18 +412,7 @@ pub fn characterise_with(
                             sum[slot] += v;
                         }
                         if opts.errors {
-                            // one sample's total per element, then its square
-                            hits.sort_unstable_by_key(|h| h.0);
-                            let mut j = 0;
-                            while j < hits.len() {
-                                let (slot, mut v) = hits[j];
-                                j += 1;
-                                while j < hits.len() && hits[j].0 == slot {
-                                    v += hits[j].1;
-                                    j += 1;
-                                }
-                                sq[slot] += v * v;
-                            }
+                            add_squares(&mut hits, &mut sq);
                         }
                     }
                     done();

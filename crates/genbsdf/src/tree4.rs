@@ -18,7 +18,8 @@ use rayon::prelude::*;
 use crate::reduce::{reciprocity, reduce, Grid};
 use crate::reduce_stream::{Rows, StreamReduce};
 use crate::{
-    direction_strata, grid, plane_point, sample_seed, setup, sides, Characterised, Options, Setup,
+    add_squares, direction_strata, grid, plane_point, sample_seed, setup, sides, Characterised,
+    Options, Setup,
 };
 
 /// The grid cell of a unit direction of travel (its x and y on the disk).
@@ -228,18 +229,7 @@ pub fn characterise(
                     }
                 });
                 if opts.errors {
-                    // one sample's total per cell, then its square
-                    hits.sort_unstable_by_key(|h| h.0);
-                    let mut j = 0;
-                    while j < hits.len() {
-                        let (slot, mut v) = hits[j];
-                        j += 1;
-                        while j < hits.len() && hits[j].0 == slot {
-                            v += hits[j].1;
-                            j += 1;
-                        }
-                        sq[slot] += v * v;
-                    }
+                    add_squares(&mut hits, &mut sq);
                 }
             }
             (trans, refl, sq)
