@@ -356,6 +356,46 @@ fn reference_glass_window_distribution_and_proxy() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A window that sees a small, very bright patch (a white patch in full sun, off the
+/// window's normal, against a dim sky) gets a warning naming the peak and what to do;
+/// the same window without the sun gets none. (A peak straddling the pole's cells, which
+/// meet at the normal, is shared among them and not reported.)
+#[test]
+fn a_peak_in_the_distribution_is_reported() {
+    let root = common::scratch("mkillum-peak");
+    for sun in [true, false] {
+        let d = root.join(if sun { "sun" } else { "plain" });
+        std::fs::create_dir_all(&d).unwrap();
+        let mut scene = String::from(
+            "void glow dim 0 0 4 .01 .01 .01 0\ndim source sky 0 0 4 0 0 1 180\n\
+             void plastic white 0 0 5 .8 .8 .8 0 0\n\
+             white polygon patch 0 0 12 1.2 0.1 1.5  1.2 0.4 1.5  1.5 0.4 1.5  1.5 0.1 1.5\n",
+        );
+        if sun {
+            scene.push_str(
+                "void light solar 0 0 3 1e6 1e6 1e6\nsolar source sun 0 0 4 0 0 -1 0.5\n",
+            );
+        }
+        std::fs::write(d.join("scene.rad"), scene).unwrap();
+        let mut mk = ours(&d);
+        mk.args(["-ab", "0", "scene.rad"]);
+        let out = common::run_stdin(
+            mk,
+            b"#@mkillum c=d d=6 s=64\nvoid polygon w 0 0 12 0 0 0 0 0.5 0 0.5 0.5 0 0.5 0 0\n",
+        );
+        assert!(out.status.success());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(err.contains("carries"), sun, "{err}");
+        if sun {
+            assert!(
+                err.contains("polygon \"w\"") && err.contains("raise d= (now 6)"),
+                "{err}"
+            );
+        }
+    }
+    let _ = std::fs::remove_dir_all(&root);
+}
+
 #[test]
 fn same_output_for_any_thread_count() {
     let root = common::scratch("mkillum-threads");

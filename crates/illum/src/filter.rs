@@ -452,6 +452,18 @@ impl<'a> Filter<'a> {
             });
         }
         if self.settings.sampdens > 0 {
+            if let Some(share) = dist.peak() {
+                // Radiance spreads such a peak over its cell without a word
+                warn(format!(
+                    "{} \"{}\": one of its {} directions carries {:.0}% of the light leaving it (a peak, as of a sun by way of specular surfaces), spread here over a cell of {:.3} sr (projected); raise d= (now {}) or sample the source with l+",
+                    p.ptype,
+                    p.name,
+                    dist.sums.len(),
+                    100.0 * share,
+                    std::f64::consts::PI / dist.sums.len() as f64,
+                    self.settings.sampdens
+                ));
+            }
             write::distribution(out, &mut self.settings, &dist, col, axes)?;
         } else if p.ptype == "sphere" {
             warn(format!("sphere \"{}\": diffuse distribution", p.name));

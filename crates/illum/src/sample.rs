@@ -61,6 +61,23 @@ impl Distribution {
         a.map(|x| x / n / s)
     }
 
+    /// A peak: the share of the light (the bins hold equal projected solid angles) in the
+    /// brightest bin, when that bin holds more than a quarter of it and is over 20 times the
+    /// median bin (a sun seen by way of specular surfaces, which a cell spreads out).
+    pub fn peak(&self) -> Option<f64> {
+        let lum: Vec<f64> = self.sums.iter().map(|v| crate::bright(*v)).collect();
+        let total: f64 = lum.iter().sum();
+        if lum.len() < 4 || total.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+            return None;
+        }
+        let max = lum.iter().copied().fold(0.0f64, f64::max);
+        let mut sorted = lum.clone();
+        sorted.sort_by(f64::total_cmp);
+        let median = sorted[sorted.len() / 2];
+        let share = max / total;
+        (share > 0.25 && max > 20.0 * median).then_some(share)
+    }
+
     /// Standard error of each bin's mean luminance (from its rays' spread).
     pub fn std_errors(&self) -> Vec<f64> {
         let s = self.nsamps as f64;
