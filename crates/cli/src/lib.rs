@@ -2,17 +2,15 @@
 //! (`-ab 4`, `-faf`, `-vd x y z`, `+f`/`-f`, `@optfile`), RAYPATH look-up, inputs
 //! (`-`, `!command`), atomic output files, progress bars and error printing.
 
-pub mod cleanup;
 pub mod expand;
-pub mod input;
 pub mod num;
 pub mod opts;
-pub mod output;
 pub mod printf;
 pub mod progress;
-pub mod raypath;
 pub mod rays;
 mod run;
+
+pub use fenestra_io::{cleanup, input, output, raypath};
 pub mod threads;
 pub use threads::peak_rss_kb;
 

@@ -1,20 +1,8 @@
 //! The entry point wrapper every tool binary calls, program name and messages.
 
 use std::process::ExitCode;
-use std::sync::OnceLock;
 
-static PROG: OnceLock<String> = OnceLock::new();
-static WARNINGS: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(true);
-
-/// Whether warnings are printed.
-pub fn warnings_on() -> bool {
-    WARNINGS.load(std::sync::atomic::Ordering::Relaxed)
-}
-
-/// Turns warnings on or off (Radiance's `-w`).
-pub fn set_warnings(on: bool) {
-    WARNINGS.store(on, std::sync::atomic::Ordering::Relaxed);
-}
+pub use fenestra_io::diag::{prog, set_prog, set_warnings, warn, warnings_on};
 
 /// A request to end the program quietly with the given status (e.g. after `--help`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -27,28 +15,6 @@ impl std::fmt::Display for Exit {
 }
 
 impl std::error::Error for Exit {}
-
-/// Sets the program name used in messages (done by [`main_with`]; tests may call it).
-pub fn set_prog(name: &str) {
-    let base = std::path::Path::new(name)
-        .file_name()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| name.to_string());
-    let _ = PROG.set(base);
-}
-
-/// The program name used in messages (`fenestra` until set).
-pub fn prog() -> &'static str {
-    PROG.get().map(String::as_str).unwrap_or("fenestra")
-}
-
-/// Prints `prog: warning - msg` on stderr, as Radiance tools do.
-pub fn warn(msg: impl std::fmt::Display) {
-    if !WARNINGS.load(std::sync::atomic::Ordering::Relaxed) {
-        return;
-    }
-    eprintln!("{}: warning - {}", prog(), msg);
-}
 
 /// Runs a tool: expands `@file`/`$VAR` arguments, sets the program name, and turns
 /// an error into `prog: fatal - message` with exit status 1.

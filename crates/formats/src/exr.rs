@@ -81,7 +81,7 @@ pub fn write_picture_file(
     use anyhow::Context;
     use std::io::Write;
     let path = path.as_ref();
-    let mut out = fenestra_cli::output::AtomicFile::create(path)?;
+    let mut out = fenestra_io::output::AtomicFile::create(path)?;
     if is_exr_path(path) {
         let bytes = encode_exr(header, width, height, pixels)
             .with_context(|| format!("{}", path.display()))?;

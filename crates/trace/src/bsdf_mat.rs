@@ -385,7 +385,7 @@ pub fn compile(p: &Primitive) -> Result<BsdfMat> {
             p.sargs[4 + o]
         );
     }
-    let path = fenestra_cli::raypath::find_or_err(&p.sargs[o])
+    let path = fenestra_io::raypath::find_or_err(&p.sargs[o])
         .with_context(|| format!("{}: BSDF '{}'", p.loc, p.name))?;
     let b = fenestra_bsdf::read_file(&path)
         .map_err(|e| anyhow::anyhow!("{}: BSDF '{}': {e}", p.loc, p.name))?;

@@ -58,7 +58,7 @@ impl CalSource {
         match self {
             CalSource::Expr(e) => p.load_str("-e", e).map_err(|e| anyhow::anyhow!("{e}")),
             CalSource::File(f) => {
-                let path = fenestra_cli::raypath::find_or_err(f)?;
+                let path = fenestra_io::raypath::find_or_err(f)?;
                 p.load_file(&path).map_err(|e| anyhow::anyhow!("{e}"))
             }
         }

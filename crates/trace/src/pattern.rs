@@ -81,13 +81,13 @@ const TRIAL: PatternInput = PatternInput {
 /// line's `-e`/`-f` sources, then the pattern's own file (`.` for none).
 fn program(user: &[CalSource], cal: &str) -> Result<Program> {
     let mut p = Program::for_renderer();
-    let init = fenestra_cli::raypath::find_or_err("rayinit.cal")?;
+    let init = fenestra_io::raypath::find_or_err("rayinit.cal")?;
     p.load_file(&init).map_err(|e| anyhow!("{e}"))?;
     for c in user {
         c.load(&mut p)?;
     }
     if cal != "." {
-        let path = fenestra_cli::raypath::find_or_err(cal)?;
+        let path = fenestra_io::raypath::find_or_err(cal)?;
         p.load_file(&path).map_err(|e| anyhow!("{e}"))?;
     }
     Ok(p)
@@ -376,8 +376,7 @@ fn compile_data(q: &fenestra_scene::Primitive, what: &str, user: &[CalSource]) -
     }
     let mut grids = Vec::new();
     for name in &q.sargs[nf..2 * nf] {
-        let path =
-            fenestra_cli::raypath::find_or_err(name).map_err(|e| anyhow!("{what}: {e:#}"))?;
+        let path = fenestra_io::raypath::find_or_err(name).map_err(|e| anyhow!("{what}: {e:#}"))?;
         grids.push(DataGrid::read(&path).map_err(|e| anyhow!("{what}: {e:#}"))?);
     }
     let dims = grids[0].dims();
@@ -395,7 +394,7 @@ fn compile_data(q: &fenestra_scene::Primitive, what: &str, user: &[CalSource]) -
     let (coords, xf) = coords.split_at(dims);
     if xf.is_empty() && user.is_empty() {
         let text = |name: &str| {
-            fenestra_cli::raypath::find(name).and_then(|p| std::fs::read_to_string(p).ok())
+            fenestra_io::raypath::find(name).and_then(|p| std::fs::read_to_string(p).ok())
         };
         if let (Some(c), Some(r)) = (text(cal), text("rayinit.cal")) {
             let nf = q.sargs[..nf].to_vec();

@@ -61,7 +61,7 @@ impl Matrix {
             nrows += 1;
         }
         if r.has_trailing_data() {
-            fenestra_cli::warn(format!(
+            fenestra_io::warn(format!(
                 "{}: data beyond the {} rows of the header ignored",
                 r.name(),
                 nrows

@@ -108,7 +108,7 @@ impl MatrixReader {
     /// For a file in a binary format without `NROWS=`, the row count is inferred from
     /// its size; a size too small for `NROWS=` is an error at once.
     pub fn open(name: &str) -> Result<MatrixReader> {
-        let r = fenestra_cli::input::open(name)?;
+        let r = fenestra_io::input::open(name)?;
         let mut m = Self::from_boxed(r, name)?;
         if name != "-" && !name.is_empty() && !name.starts_with('!') {
             if let Ok(meta) = std::fs::metadata(name) {
@@ -267,7 +267,7 @@ impl MatrixReader {
                     );
                 }
                 if (data as u128) > need {
-                    fenestra_cli::warn(format!(
+                    fenestra_io::warn(format!(
                         "{}: {} bytes of data beyond NROWS={} NCOLS={} NCOMP={} ignored",
                         self.name,
                         data as u128 - need,
@@ -336,7 +336,7 @@ impl MatrixReader {
         if !self.warned_nonfinite && out.iter().any(|v| !v.is_finite()) {
             // carried through as Radiance does, but never silently
             self.warned_nonfinite = true;
-            fenestra_cli::warn(format!(
+            fenestra_io::warn(format!(
                 "{}: row {} holds a value that is not a finite number (nan or inf); results that use it will be too",
                 self.name, self.rows_read
             ));
