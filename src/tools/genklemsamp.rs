@@ -40,12 +40,8 @@ fn spec() -> Spec {
     s
 }
 
-#[derive(Clone, Copy, PartialEq)]
-enum Fmt {
-    Ascii,
-    Float,
-    Double,
-}
+/// The `-f` number-stream format (one type for every tool).
+type Fmt = fenestra_cli::rays::RayFormat;
 
 /// Runs genklemsamp.
 pub fn run(args: Vec<String>) -> Result<ExitCode> {

@@ -32,23 +32,19 @@ fn spec() -> Spec {
     .opt(Opt::new("P", Kind::Flag, "passive mode (not supported)"))
 }
 
-#[derive(Clone, Copy, PartialEq)]
-enum Fmt {
-    Ascii,
-    Float,
-    Double,
-}
+/// The `-f` number-stream format (one type for every tool).
+type Fmt = fenestra_cli::rays::RayFormat;
 
 fn parse_fmt(opt: &str, w: &str) -> Result<(Fmt, usize)> {
     let mut ch = w.chars();
     let f = match ch.next() {
-        Some('a') => Fmt::Ascii,
-        Some('f') => Fmt::Float,
-        Some('d') => Fmt::Double,
         None => bail!(
             "option -{opt} with a template file is not supported by fenestra (use -{opt}a, -{opt}f or -{opt}d)"
         ),
-        Some(c) => bail!("option -{opt}{w}: unknown format '{c}' (expected a, f or d)"),
+        Some(c) => match Fmt::from_letter(c) {
+            Some(f) => f,
+            None => bail!("option -{opt}{w}: unknown format '{c}' (expected a, f or d)"),
+        },
     };
     let rest: String = ch.collect();
     let n = if rest.is_empty() {

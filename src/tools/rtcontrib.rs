@@ -149,16 +149,12 @@ pub fn run_with(
         }
         if a == "-defaults" {
             let pm = |b: bool| if b { '+' } else { '-' };
-            let f = |x: InFormat| match x {
-                InFormat::Ascii => 'a',
-                InFormat::Float => 'f',
-                InFormat::Double => 'd',
-            };
+            let f = |x: InFormat| x.letter();
             let g = match fout {
                 Format::Ascii => 'a',
                 Format::Float => 'f',
                 Format::Double => 'd',
-                Format::Rgbe => 'c',
+                Format::Rgbe | Format::Xyze => 'c',
             };
             let lines = [
                 format!("-c {count:<8}\t\t# accumulated rays per record"),
@@ -244,13 +240,11 @@ pub fn run_with(
             if c.len() > 2 {
                 bail!("Illegal i/o format '{a}'");
             }
-            fin = match c[0] {
-                'a' => InFormat::Ascii,
-                'f' => InFormat::Float,
-                'd' => InFormat::Double,
-                _ => bail!("Illegal i/o format '{a}' (input: a, f, d)"),
+            fin = match InFormat::from_letter(c[0]) {
+                Some(f) => f,
+                None => bail!("Illegal i/o format '{a}' (input: a, f, d)"),
             };
-            fout = Format::from_letter(*c.get(1).unwrap_or(&c[0]), true)?;
+            fout = fenestra_contrib::output::format_of(*c.get(1).unwrap_or(&c[0]), true)?;
         } else {
             let name = &a[1..];
             match name {

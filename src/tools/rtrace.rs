@@ -32,20 +32,14 @@ const RTRACE_OPTIONS: &str = "Options:
   -defaults        print the values in effect;  -version
 Full documentation: fenestra doc rtrace (docs/tools/rtrace.md in the source).";
 
-#[derive(Clone, Copy, PartialEq)]
-enum Fmt {
-    Ascii,
-    Float,
-    Double,
-}
+/// The `-f` number-stream format (one type for every tool).
+type Fmt = fenestra_cli::rays::RayFormat;
 
 fn fmt_of(c: char) -> Result<Fmt> {
-    Ok(match c {
-        'a' => Fmt::Ascii,
-        'f' => Fmt::Float,
-        'd' => Fmt::Double,
-        _ => bail!("unsupported data format '{c}' (fenestra supports a, f, d)"),
-    })
+    match Fmt::from_letter(c) {
+        Some(f) => Ok(f),
+        None => bail!("unsupported data format '{c}' (fenestra supports a, f, d)"),
+    }
 }
 
 fn num(args: &[String], i: usize) -> Result<f64> {
@@ -88,11 +82,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         if a == "-defaults" {
             // Radiance's layout, with the values in effect (those given before it)
             let pm = |b: bool| if b { '+' } else { '-' };
-            let fc = |f: Fmt| match f {
-                Fmt::Ascii => 'a',
-                Fmt::Float => 'f',
-                Fmt::Double => 'd',
-            };
+            let fc = |f: Fmt| f.letter();
             let lines = [
                 format!(
                     "-w{}\t\t\t\t# warning messages {}",
@@ -327,11 +317,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let stdin = std::io::stdin();
     let mut reader = fenestra_cli::rays::RayReader::new(
         std::io::BufReader::with_capacity(1 << 16, stdin.lock()),
-        match fin {
-            Fmt::Ascii => fenestra_cli::rays::RayFormat::Ascii,
-            Fmt::Float => fenestra_cli::rays::RayFormat::Float,
-            Fmt::Double => fenestra_cli::rays::RayFormat::Double,
-        },
+        fin,
     );
     let mut k0 = 0usize;
     let mut schedule = fenestra_cli::rays::FlushSchedule::new(flush_every);

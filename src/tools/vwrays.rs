@@ -33,12 +33,8 @@ fn spec() -> Spec {
     s
 }
 
-#[derive(Clone, Copy, PartialEq)]
-enum Fmt {
-    Ascii,
-    Float,
-    Double,
-}
+/// The `-f` number-stream format (one type for every tool).
+type Fmt = fenestra_cli::rays::RayFormat;
 
 struct Settings {
     fmt: Fmt,

@@ -59,7 +59,7 @@ pub fn header_text(plan: &StreamPlan, info: &HeaderInfo) -> Vec<u8> {
             let be = if cfg!(target_endian = "big") { 1 } else { 0 };
             h.push_str(&format!("BigEndian={be}\n"));
         }
-        h.push_str(&format!("FORMAT={}\n\n", info.format.header_name()));
+        h.push_str(&format!("FORMAT={}\n\n", info.format.as_str()));
     }
     if info.xres > 0 && info.yres > 0 && one {
         h.push_str(&format!("-Y {:8} +X {:8}\n", info.yres, info.xres));

@@ -11,7 +11,7 @@ pub use header::{header_text, HeaderInfo};
 pub use layout::{plan, ModOut, StreamPlan};
 use recover::PartialFile;
 pub use recover::{check_files, examine_partial, partial_path, record_size, reload_sums, Partial};
-pub use spec::{Format, Spec};
+pub use spec::{format_of, Format, Spec};
 pub use stream::Stream;
 
 #[cfg(test)]

@@ -119,7 +119,7 @@ pub fn record_size(plan: &StreamPlan, format: Format) -> Option<u64> {
         Format::Ascii => return None,
         Format::Float => 12,
         Format::Double => 24,
-        Format::Rgbe => 4,
+        Format::Rgbe | Format::Xyze => 4,
     };
     Some(per * plan.items.len() as u64)
 }
@@ -168,7 +168,7 @@ pub fn examine_partial(plan: &StreamPlan, format: Format) -> Result<Option<Parti
     };
     if h > 0 {
         let head = String::from_utf8_lossy(&data[..h]);
-        let want = format!("FORMAT={}", format.header_name());
+        let want = format!("FORMAT={}", format.as_str());
         if !head.lines().any(|l| l == want) {
             bail!("cannot recover '{name}': its header does not say {want}");
         }

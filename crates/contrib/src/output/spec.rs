@@ -2,39 +2,19 @@
 
 use anyhow::{bail, Result};
 
-/// Output data format (`-fXo`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Format {
-    /// Text, `%.6e` and a tab per value.
-    Ascii,
-    /// 32-bit floats, native byte order.
-    Float,
-    /// 64-bit floats, native byte order.
-    Double,
-    /// RGBE, 4 bytes per bin.
-    Rgbe,
-}
+/// Output data format (`-fXo`): the matrix formats of `fenestra_formats` (one type for
+/// every matrix any tool writes); rtcontrib writes all but XYZE.
+pub use fenestra_formats::DataFormat as Format;
 
-impl Format {
-    /// The format letter's meaning (`a f d c`).
-    pub fn from_letter(c: char, output: bool) -> Result<Format> {
-        Ok(match c {
-            'a' => Format::Ascii,
-            'f' => Format::Float,
-            'd' => Format::Double,
-            'c' if output => Format::Rgbe,
-            _ => bail!("Illegal i/o format '{c}' (input: a, f, d; output: a, f, d, c)"),
-        })
-    }
-
-    pub(super) fn header_name(self) -> &'static str {
-        match self {
-            Format::Ascii => "ascii",
-            Format::Float => "float",
-            Format::Double => "double",
-            Format::Rgbe => "32-bit_rle_rgbe",
-        }
-    }
+/// The output format of a `-f` letter (`a f d c`; `c`, RGBE, for output only).
+pub fn format_of(c: char, output: bool) -> Result<Format> {
+    Ok(match c {
+        'a' => Format::Ascii,
+        'f' => Format::Float,
+        'd' => Format::Double,
+        'c' if output => Format::Rgbe,
+        _ => bail!("Illegal i/o format '{c}' (input: a, f, d; output: a, f, d, c)"),
+    })
 }
 
 /// A parsed `-o` spec: where its `%s` and bin field are.

@@ -188,7 +188,9 @@ impl Stream {
             let (m, b) = self.plan.items[k];
             let s = value(m, b);
             let v = match format {
-                Format::Float | Format::Rgbe => s.map(|x| ((x as f32) * (scale as f32)) as f64),
+                Format::Float | Format::Rgbe | Format::Xyze => {
+                    s.map(|x| ((x as f32) * (scale as f32)) as f64)
+                }
                 _ => s.map(|x| x * scale),
             };
             match format {
@@ -210,7 +212,7 @@ impl Stream {
                         self.buf.extend_from_slice(&c.to_ne_bytes());
                     }
                 }
-                Format::Rgbe => {
+                Format::Rgbe | Format::Xyze => {
                     if let Dest::Exr(e) = &mut self.dest {
                         e.pixels.push([v[0] as f32, v[1] as f32, v[2] as f32]);
                         continue;
