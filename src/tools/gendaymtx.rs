@@ -224,47 +224,30 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let mut out = std::io::BufWriter::with_capacity(1 << 20, stdout.lock());
     if header {
         let site = daymtx::tape_site(&tape);
-        let mut h = String::new();
-        h.push_str("#?RADIANCE\n");
-        h.push_str(&fenestra_cli::command_line(&args));
-        h.push('\n');
-        h.push_str(&format!(
-            "LATLONG= {:.8} {:.8}\n",
+        let mut h = fenestra_formats::header::Header::radiance();
+        h.push(fenestra_cli::command_line(&args));
+        h.push(format!(
+            "LATLONG= {:.8} {:.8}",
             site.latitude * (180.0 / PI),
             -(site.longitude * (180.0 / PI))
         ));
-        h.push_str(&format!("NROWS={n}\nNCOLS={ncols}\n"));
-        if average {
-            h.push_str(&format!("NAVERAGED={}\n", steps.len()));
-        }
-        h.push_str("NCOMP=3\n");
-        let fmt = match outfmt {
-            'f' => "float",
-            'd' => "double",
-            _ => "ascii",
+        let opts = fenestra_formats::WriteOptions {
+            format: match outfmt {
+                'f' => fenestra_formats::DataFormat::Float,
+                'd' => fenestra_formats::DataFormat::Double,
+                _ => fenestra_formats::DataFormat::Ascii,
+            },
+            header: Some(h),
+            align_from: fenestra_cli::output::stdout_file_offset(),
+            ..Default::default()
         };
-        if outfmt != 'a' {
-            h.push_str(&format!(
-                "BigEndian={}\n",
-                u8::from(cfg!(target_endian = "big"))
-            ));
-        }
-        h.push_str("FORMAT=");
-        h.push_str(fmt);
-        let align = match outfmt {
-            'f' => 4,
-            'd' => 8,
-            _ => 0,
+        let averaged = if average {
+            vec![format!("NAVERAGED={}", steps.len())]
+        } else {
+            Vec::new()
         };
-        if align > 0 {
-            if let Some(pos) = stdout_position() {
-                let p = pos + h.len() as u64 + 2;
-                let pad = (align - p % align) % align;
-                h.push_str(&" ".repeat(pad as usize));
-            }
-        }
-        h.push_str("\n\n");
-        out.write_all(h.as_bytes())?;
+        let h = fenestra_formats::matrix::header_bytes(Some(n), ncols, 3, &opts, &averaged)?;
+        out.write_all(&h)?;
     }
     let m = 3 * n;
     for p in 0..n {
@@ -310,17 +293,4 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         eprintln!("{}: done.", fenestra_cli::prog());
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// Current offset of standard output when it is a regular file (Radiance pads a
-/// binary FORMAT line so the data start aligned; through a pipe it cannot).
-fn stdout_position() -> Option<u64> {
-    let meta = std::fs::metadata("/proc/self/fd/1").ok()?;
-    if !meta.is_file() {
-        return None;
-    }
-    let info = std::fs::read_to_string("/proc/self/fdinfo/1").ok()?;
-    info.lines()
-        .find_map(|l| l.strip_prefix("pos:"))
-        .and_then(|v| v.trim().parse().ok())
 }

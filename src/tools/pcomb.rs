@@ -173,14 +173,13 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         bail!("illegal output resolution (give -x and -y when there are no inputs)");
     }
 
-    let mut head = String::from("#?RADIANCE\n");
+    let mut info = fenestra_formats::header::Header::radiance();
     for l in capdate_lines() {
-        head.push_str(&l);
-        head.push('\n');
+        info.push(l);
     }
     if echo {
         for inp in &inputs {
-            head.push_str(&format!("{}:\n", inp.name));
+            info.push(format!("{}:", inp.name));
             for l in &inp.lines {
                 if l.starts_with("#?")
                     || l.starts_with("FORMAT=")
@@ -191,25 +190,33 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 {
                     continue;
                 }
-                head.push('\t');
-                head.push_str(l);
-                head.push('\n');
+                info.push(format!("\t{l}"));
             }
         }
     }
-    head.push_str(&fenestra_cli::command_line(&args));
-    head.push('\n');
+    info.push(fenestra_cli::command_line(&args));
     if let Some(v) = inputs.iter().find_map(|i| i.view.as_ref()) {
-        head.push_str(&v.header_line());
-        head.push('\n');
+        info.push(v.header_line());
     }
-    if float_out {
-        head.push_str(&format!(
-            "NROWS={yres}\nNCOLS={xres}\nNCOMP=3\nBigEndian={}\nFORMAT=float\n\n",
-            u8::from(cfg!(target_endian = "big"))
-        ));
-    } else {
-        head.push_str("FORMAT=32-bit_rle_rgbe\n\n");
+    // one header writer for every matrix and picture (the picture's resolution line is ours)
+    let opts = fenestra_formats::WriteOptions {
+        format: if float_out {
+            fenestra_formats::DataFormat::Float
+        } else {
+            fenestra_formats::DataFormat::Rgbe
+        },
+        header: Some(info),
+        ..Default::default()
+    };
+    let mut head = String::from_utf8(fenestra_formats::matrix::header_bytes(
+        Some(yres),
+        xres,
+        3,
+        &opts,
+        &[],
+    )?)
+    .context("header text")?;
+    if !float_out {
         head.push_str(&fenestra_formats::resolution::Resolution::standard(xres, yres).to_string());
     }
 

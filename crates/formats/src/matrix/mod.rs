@@ -11,7 +11,7 @@ mod writer;
 pub use ascii::{format_c_e, format_c_g};
 pub use dense::Matrix;
 pub use reader::{read_full, MatrixInfo, MatrixReader};
-pub use writer::{AsciiLayout, MatrixWriter, WriteOptions};
+pub use writer::{header_bytes, AsciiLayout, MatrixWriter, WriteOptions};
 
 /// How the numbers of a matrix are stored.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -66,6 +66,54 @@ impl WriteOptions {
 }
 
 /// Writes a matrix row by row.
+/// The header every fenestra tool writes before matrix (or picture) data: the information
+/// lines (`#?RADIANCE` first if missing), then for a matrix `NROWS` (unless not asked or
+/// unknown), `NCOLS`, the lines `after_ncols` (gendaymtx's `NAVERAGED`), `NCOMP`; then
+/// `BigEndian` for binary values, `FORMAT` (padded with `align_from` so the data start
+/// aligned) and the blank line. A picture's resolution line is the caller's. Empty without
+/// `opts.header`.
+pub fn header_bytes(
+    nrows: Option<usize>,
+    ncols: usize,
+    ncomp: usize,
+    opts: &WriteOptions,
+    after_ncols: &[String],
+) -> Result<Vec<u8>> {
+    let Some(h) = &opts.header else {
+        return Ok(Vec::new());
+    };
+    let format = opts.format;
+    let mut text = Vec::with_capacity(256);
+    if !h.lines.first().is_some_and(|l| l.starts_with("#?")) {
+        text.extend_from_slice(b"#?RADIANCE\n");
+    }
+    h.write_lines(&mut text)?;
+    if !format.is_picture() {
+        if opts.write_nrows {
+            if let Some(n) = nrows {
+                writeln!(text, "NROWS={n}")?;
+            }
+        }
+        writeln!(text, "NCOLS={ncols}")?;
+        for l in after_ncols {
+            writeln!(text, "{l}")?;
+        }
+        writeln!(text, "NCOMP={ncomp}")?;
+    }
+    if format.value_size().is_some() {
+        writeln!(text, "BigEndian={}", opts.big_endian as u8)?;
+    }
+    write!(text, "FORMAT={}", format.as_str())?;
+    if let Some(off) = opts.align_from {
+        let align = format.alignment() as u64;
+        while (off + text.len() as u64 + 2) % align != 0 {
+            text.push(b' ');
+        }
+    }
+    text.extend_from_slice(b"\n\n");
+    Ok(text)
+}
+
 pub struct MatrixWriter<W: Write> {
     w: W,
     format: DataFormat,
@@ -93,36 +141,11 @@ impl<W: Write> MatrixWriter<W> {
         if format.is_picture() && ncomp != 3 && ncomp != 1 {
             bail!("{format} output needs 1 or 3 components per element, the matrix has {ncomp}");
         }
-        if let Some(h) = &opts.header {
-            let mut text = Vec::with_capacity(256);
-            if !h.lines.first().is_some_and(|l| l.starts_with("#?")) {
-                text.extend_from_slice(b"#?RADIANCE\n");
+        if opts.header.is_some() {
+            if format.is_picture() && nrows.is_none() {
+                bail!("{format} output needs the row count in advance");
             }
-            h.write_lines(&mut text)?;
-            if format.is_picture() {
-                if nrows.is_none() {
-                    bail!("{format} output needs the row count in advance");
-                }
-            } else {
-                if opts.write_nrows {
-                    if let Some(n) = nrows {
-                        writeln!(text, "NROWS={n}")?;
-                    }
-                }
-                writeln!(text, "NCOLS={ncols}")?;
-                writeln!(text, "NCOMP={ncomp}")?;
-            }
-            if format.value_size().is_some() {
-                writeln!(text, "BigEndian={}", opts.big_endian as u8)?;
-            }
-            write!(text, "FORMAT={}", format.as_str())?;
-            if let Some(off) = opts.align_from {
-                let align = format.alignment() as u64;
-                while (off + text.len() as u64 + 2) % align != 0 {
-                    text.push(b' ');
-                }
-            }
-            text.extend_from_slice(b"\n\n");
+            let mut text = header_bytes(nrows, ncols, ncomp, opts, &[])?;
             if format.is_picture() {
                 writeln!(text, "-Y {:8} +X {:8}", nrows.unwrap_or(0), ncols)?;
             }
