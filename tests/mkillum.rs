@@ -391,6 +391,22 @@ fn a_peak_in_the_distribution_is_reported() {
                 err.contains("polygon \"w\"") && err.contains("raise d= (now 6)"),
                 "{err}"
             );
+            // p+ (fenestra): sampled again at 4x the density until no cell holds the peak
+            let mut mk = ours(&d);
+            mk.args(["-ab", "0", "scene.rad"]);
+            let out = common::run_stdin(
+                mk,
+                b"#@mkillum c=d d=6 s=64 p+ f=fine\nvoid polygon w 0 0 12 0 0 0 0 0.5 0 0.5 0.5 0 0.5 0 0\n",
+            );
+            assert!(out.status.success());
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert!(err.contains("at d=6: sampled again at d=24 (p+)"), "{err}");
+            assert!(!err.contains("raise d="), "{err}");
+            // the data file holds the finer grid: 80 directions at d=24 or 300 at d=96
+            // (the pole row added), not 12
+            let (grid, _) = datafile(&d.join("fineR.dat"));
+            let cells: usize = grid.iter().map(|g| g.2).product();
+            assert!(cells > 12 * 4, "{grid:?}");
         }
     }
     let _ = std::fs::remove_dir_all(&root);

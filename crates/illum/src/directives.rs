@@ -54,6 +54,9 @@ pub struct Settings {
     pub bsdf: Option<String>,
     /// `u=`: the BSDF's up vector (fenestra; default +Z, or +Y for a window facing up or down).
     pub up: Option<glam::DVec3>,
+    /// `p+`: a distribution with a peak in one cell is sampled again at 4× the density, up
+    /// to twice (fenestra; `p-`, the default, only warns).
+    pub refine: bool,
 }
 
 impl Default for Settings {
@@ -71,6 +74,7 @@ impl Default for Settings {
             minbrt: 0.0,
             bsdf: None,
             up: None,
+            refine: false,
         }
     }
 }
@@ -260,6 +264,17 @@ impl Settings {
                 }
                 Some(b'-') => {
                     self.light = false;
+                    w.len() == 2
+                }
+                _ => false,
+            },
+            b'p' => match w.as_bytes().get(1) {
+                Some(b'+') => {
+                    self.refine = true;
+                    w.len() == 2
+                }
+                Some(b'-') => {
+                    self.refine = false;
                     w.len() == 2
                 }
                 _ => false,

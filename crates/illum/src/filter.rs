@@ -310,10 +310,55 @@ impl<'a> Filter<'a> {
     }
 
     fn convert(&mut self, p: &Prim, name: &str, out: &mut String) -> Result<()> {
+        let bsdf = self
+            .settings
+            .bsdf
+            .as_ref()
+            .and_then(|f| self.bsdfs.get(f))
+            .cloned();
+        if let Some(data) = bsdf {
+            let job = self.job(p, self.settings.sampdens);
+            return self.convert_bsdf(p, name, out, &job, &data);
+        }
+        let keep = self.settings.sampdens;
+        let mut dens = keep;
+        let result = loop {
+            let job = self.job(p, dens);
+            let Some((dist, axes)) = self.sample_traced(p, name, out, &job)? else {
+                return Ok(());
+            };
+            // p+: a peak in one cell: the surface again at 4× the density (at most d=4096)
+            let refine = self.settings.refine && dens > 0 && dens * 4 <= 4096;
+            match dist.peak() {
+                Some(share) if refine => {
+                    warn(format!(
+                        "{} \"{}\": one of its {} directions carries {:.0}% of the light at d={dens}: sampled again at d={} (p+)",
+                        p.ptype,
+                        p.name,
+                        dist.sums.len(),
+                        100.0 * share,
+                        dens * 4
+                    ));
+                    dens *= 4;
+                }
+                _ => break (dist, axes),
+            }
+        };
+        // the distribution is written at the density used
+        self.settings.sampdens = dens;
+        let r = self.finish_surface(p, out, result.0, result.1);
+        self.settings.sampdens = keep;
+        r
+    }
+
+    /// The sampling job of surface `p` at density `dens` (counts the surface).
+    fn job(&mut self, p: &Prim, dens: i64) -> Job<'a> {
         let il = &self.settings;
+        let mut at = il.clone();
+        at.sampdens = dens;
         let (nalt, nazi) = match p.ptype.as_str() {
-            "sphere" => il.round_divisions(),
-            _ => il.flat_divisions(),
+            "sphere" => at.round_divisions(),
+            _ => at.flat_divisions(),
         };
         let nsamps = il.nsamps.max(1) as usize;
         self.surfaces += 1;
@@ -340,16 +385,24 @@ impl<'a> Filter<'a> {
             };
             pr.restart(rays as u64, &format!("mkillum {}", p.name));
         }
-        let bsdf = il.bsdf.as_ref().and_then(|f| self.bsdfs.get(f)).cloned();
-        if let Some(data) = bsdf {
-            return self.convert_bsdf(p, name, out, &job, &data);
-        }
-        let (dist, axes) = match p.ptype.as_str() {
+        job
+    }
+
+    /// The traced mode's distribution of `p` (with its axes), or `None` when the surface
+    /// was passed on unchanged.
+    fn sample_traced(
+        &mut self,
+        p: &Prim,
+        name: &str,
+        out: &mut String,
+        job: &Job,
+    ) -> Result<Option<(crate::sample::Distribution, Option<[glam::DVec3; 3]>)>> {
+        Ok(Some(match p.ptype.as_str() {
             "polygon" => {
                 let Some(face) = self.face_of(p, name, out)? else {
-                    return Ok(());
+                    return Ok(None);
                 };
-                match sample::face(&job, &face) {
+                match sample::face(job, &face) {
                     Some(d) => (d, Some([face.u, face.v, face.norm])),
                     None => {
                         self.pass_unchanged(
@@ -358,21 +411,21 @@ impl<'a> Filter<'a> {
                             &format!("polygon \"{}\": bad aspect", p.name),
                             name,
                         );
-                        return Ok(());
+                        return Ok(None);
                     }
                 }
             }
             "ring" => {
                 let r = Ring::new(&p.rargs)
                     .map_err(|e| anyhow::anyhow!("({name}): ring \"{}\": {e}", p.name))?;
-                (sample::ring(&job, &r), Some([r.u, r.v, r.axis]))
+                (sample::ring(job, &r), Some([r.u, r.v, r.axis]))
             }
             "sphere" => {
                 if p.rargs.len() != 4 {
                     bail!("({name}): sphere \"{}\": bad # of arguments", p.name);
                 }
                 let c = glam::DVec3::new(p.rargs[0], p.rargs[1], p.rargs[2]);
-                (sample::sphere(&job, c, p.rargs[3]), None)
+                (sample::sphere(job, c, p.rargs[3]), None)
             }
             other => {
                 self.pass_unchanged(
@@ -381,10 +434,9 @@ impl<'a> Filter<'a> {
                     &format!("cannot make illum for {other} \"{}\"", p.name),
                     name,
                 );
-                return Ok(());
+                return Ok(None);
             }
-        };
-        self.finish_surface(p, out, dist, axes)
+        }))
     }
 
     /// BSDF-data mode (`d=file.xml`) for one surface.
@@ -455,7 +507,7 @@ impl<'a> Filter<'a> {
             if let Some(share) = dist.peak() {
                 // Radiance spreads such a peak over its cell without a word
                 warn(format!(
-                    "{} \"{}\": one of its {} directions carries {:.0}% of the light leaving it (a peak, as of a sun by way of specular surfaces), spread here over a cell of {:.3} sr (projected); raise d= (now {}) or sample the source with l+",
+                    "{} \"{}\": one of its {} directions carries {:.0}% of the light leaving it (a peak, as of a sun by way of specular surfaces), spread here over a cell of {:.3} sr (projected); raise d= (now {}), give p+ (fenestra: sampled again finer) or sample the source with l+",
                     p.ptype,
                     p.name,
                     dist.sums.len(),
