@@ -65,6 +65,10 @@ fn budget_lines_and_the_total_s_error_against_independent_runs() {
         err.contains("145 records in") && err.contains("2900 primary"),
         "{err}"
     );
+    // Linux says how much memory the run held at most
+    if cfg!(target_os = "linux") {
+        assert!(err.contains("peak resident memory"), "{err}");
+    }
     assert!(
         err.contains("standard error not computed (give -E)"),
         "{err}"
@@ -137,5 +141,8 @@ fn genbsdf_and_mkillum_print_their_budget_with_v() {
         "{err}"
     );
     assert!(err.contains("surface win: mean radiance"), "{err}");
+    if cfg!(target_os = "linux") {
+        assert!(err.contains("peak resident memory"), "{err}");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -294,8 +294,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             r.indirect,
             r.specular
         );
-        if let Some(kb) = fenestra_cli::peak_rss_kb() {
-            eprintln!("{p}: peak resident memory {:.1} MB", kb as f64 / 1024.0);
+        if let Some(m) = fenestra_cli::peak_memory_line() {
+            eprintln!("{p}: {m}");
         }
     }
     Ok(ExitCode::SUCCESS)

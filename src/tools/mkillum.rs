@@ -200,6 +200,9 @@ fn budget(tracer: &Tracer, errs: &[fenestra_illum::filter::SurfaceError], second
         r.indirect,
         r.specular
     );
+    if let Some(m) = fenestra_cli::peak_memory_line() {
+        eprintln!("{p}: {m}");
+    }
     for e in errs {
         let n = e.rel.len().max(1) as f64;
         let rms = (e.rel.iter().map(|x| x * x).sum::<f64>() / n).sqrt();

@@ -712,6 +712,9 @@ pub fn run_with(
         for l in budget.lines(&names, tracer.ray_counts(), secs, tracer.effects()) {
             eprintln!("{}: {l}", fenestra_cli::prog());
         }
+        if let Some(m) = fenestra_cli::peak_memory_line() {
+            eprintln!("{}: {m}", fenestra_cli::prog());
+        }
     }
     if let Some(e) = expect {
         if total_rays < e {

@@ -390,6 +390,9 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             c.indirect,
             c.specular
         );
+        if let Some(m) = fenestra_cli::peak_memory_line() {
+            eprintln!("{}: {m}", fenestra_cli::prog());
+        }
     }
     if expect > 0 && k0 < expect {
         bail!("unexpected EOF on input");

@@ -12,7 +12,7 @@ mod run;
 
 pub use fenestra_io::{cleanup, input, output, raypath};
 pub mod threads;
-pub use threads::peak_rss_kb;
+pub use threads::{peak_memory_line, peak_rss_kb};
 
 pub use run::{
     command_line, main_with, main_with_args, prog, set_prog, set_warnings, warn, warnings_on, Exit,

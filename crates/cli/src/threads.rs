@@ -32,6 +32,11 @@ pub fn worker_count(n: f64) -> Result<usize> {
     Ok(n as usize)
 }
 
+/// The `-v` line on memory: `peak resident memory X MB` (`None` where the system does not say).
+pub fn peak_memory_line() -> Option<String> {
+    peak_rss_kb().map(|kb| format!("peak resident memory {:.1} MB", kb as f64 / 1024.0))
+}
+
 /// Peak resident memory of this process in kilobytes (Linux `VmHWM`); `None` where the
 /// system does not say.
 pub fn peak_rss_kb() -> Option<u64> {
