@@ -7,6 +7,9 @@
 //! are shared by every view in one finest cell, so each is binned once.
 
 use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+
+use rayon::prelude::*;
 
 use crate::klems::KlemsBasis;
 use crate::radiance::RgbMatrix;
@@ -32,7 +35,9 @@ pub fn transmission_with(tree: &TreeBsdf, basis: &KlemsBasis, s: usize, h: f64) 
     let s = s.max(1);
     let lam = basis.lambdas();
     let lamb = tree.lambertian(Lobe::Transmission, true) / std::f64::consts::PI;
-    let mut binned: HashMap<(usize, bool), Vec<f64>> = HashMap::new();
+    // a slice's points binned by the patch of the way their light travels (each binned once
+    // per shared slice; computed on whichever thread needs it first, the same numbers either way)
+    let binned: Mutex<HashMap<(usize, bool), Arc<Vec<f64>>>> = Mutex::new(HashMap::new());
     let bin = |slice: &crate::tree_render::Slice| {
         let mut v = vec![0.0; n];
         slice.spread(h, &mut |l, share| {
@@ -43,39 +48,54 @@ pub fn transmission_with(tree: &TreeBsdf, basis: &KlemsBasis, s: usize, h: f64) 
         });
         v
     };
-    let mut t = RgbMatrix::zeros(n, n);
-    let mut row = vec![0.0f64; n];
-    for o in 0..n {
-        row.iter_mut().for_each(|x| *x = 0.0);
-        let views: Vec<[f64; 3]> = (0..s * s)
-            .filter_map(|j| {
-                let (a, b) = ((j / s) as f64 + 0.5, (j % s) as f64 + 0.5);
-                basis.sample_projected(o, a / s as f64, b / s as f64)
-            })
-            .collect();
-        let w = 1.0 / views.len().max(1) as f64;
-        for v in &views {
-            match tree.slice(Lobe::Transmission, true, *v) {
-                Some(slice) => {
-                    let add = |row: &mut [f64], b: &[f64]| {
-                        row.iter_mut().zip(b).for_each(|(r, x)| *r += w * x)
-                    };
-                    match slice.shared_id() {
-                        Some(id) => add(&mut row, binned.entry(id).or_insert_with(|| bin(&slice))),
-                        None => add(&mut row, &bin(&slice)),
+    let rows: Vec<Vec<f64>> = (0..n)
+        .into_par_iter()
+        .map(|o| {
+            let mut row = vec![0.0f64; n];
+            let views: Vec<[f64; 3]> = (0..s * s)
+                .filter_map(|j| {
+                    let (a, b) = ((j / s) as f64 + 0.5, (j % s) as f64 + 0.5);
+                    basis.sample_projected(o, a / s as f64, b / s as f64)
+                })
+                .collect();
+            let w = 1.0 / views.len().max(1) as f64;
+            for v in &views {
+                match tree.slice(Lobe::Transmission, true, *v) {
+                    Some(slice) => {
+                        let b: Arc<Vec<f64>> = match slice.shared_id() {
+                            Some(id) => {
+                                let hit = binned.lock().ok().and_then(|m| m.get(&id).cloned());
+                                match hit {
+                                    Some(b) => b,
+                                    None => {
+                                        let b = Arc::new(bin(&slice));
+                                        if let Ok(mut m) = binned.lock() {
+                                            m.insert(id, b.clone());
+                                        }
+                                        b
+                                    }
+                                }
+                            }
+                            None => Arc::new(bin(&slice)),
+                        };
+                        row.iter_mut().zip(b.iter()).for_each(|(r, x)| *r += w * x);
                     }
-                }
-                None => {
-                    // no slice (a rank-3 tree used in reverse): the BSDF at patch centres
-                    for (i, x) in row.iter_mut().enumerate() {
-                        if let Some(b) = basis.sample_projected(i, 0.5, 0.5) {
-                            let l = [-b[0], -b[1], -b[2]];
-                            *x += w * tree.eval(Lobe::Transmission, true, *v, l).0 * lam[i];
+                    None => {
+                        // no slice (a rank-3 tree used in reverse): the BSDF at patch centres
+                        for (i, x) in row.iter_mut().enumerate() {
+                            if let Some(b) = basis.sample_projected(i, 0.5, 0.5) {
+                                let l = [-b[0], -b[1], -b[2]];
+                                *x += w * tree.eval(Lobe::Transmission, true, *v, l).0 * lam[i];
+                            }
                         }
                     }
                 }
             }
-        }
+            row
+        })
+        .collect();
+    let mut t = RgbMatrix::zeros(n, n);
+    for (o, row) in rows.iter().enumerate() {
         for i in 0..n {
             let x = row[i] + lamb * lam[i];
             t.data[o * n + i] = [x, x, x];
