@@ -15,6 +15,9 @@ use crate::klems::KlemsBasis;
 use crate::radiance::RgbMatrix;
 use crate::tree_render::{Lobe, TreeBsdf};
 
+/// Binned slices by their shared identity.
+type Binned = Mutex<HashMap<(usize, bool), Arc<Vec<f64>>>>;
+
 /// The Klems transmission matrix (`basis` × `basis`, grey) of `tree`: 16 × 16 views per
 /// patch, leaves spread at 1/256 of the concentric square (converged to 1e-4 on a blind's
 /// rank-4 tree); rank-3 slices, binned per view, at 8 × 8 and 1/64.
@@ -37,7 +40,7 @@ pub fn transmission_with(tree: &TreeBsdf, basis: &KlemsBasis, s: usize, h: f64) 
     let lamb = tree.lambertian(Lobe::Transmission, true) / std::f64::consts::PI;
     // a slice's points binned by the patch of the way their light travels (each binned once
     // per shared slice; computed on whichever thread needs it first, the same numbers either way)
-    let binned: Mutex<HashMap<(usize, bool), Arc<Vec<f64>>>> = Mutex::new(HashMap::new());
+    let binned: Binned = Mutex::new(HashMap::new());
     let bin = |slice: &crate::tree_render::Slice| {
         let mut v = vec![0.0; n];
         slice.spread(h, &mut |l, share| {
