@@ -153,6 +153,7 @@ fn oracle_tree_windows_agree_within_noise() {
         let (ta, ts) = common::mean_sem(&t);
         let (oa, os) = common::mean_sem(&o);
         let se = (ts * ts + os * os).sqrt();
+        assert!(ta > 0.0 && oa > 0.0);
         eprintln!(
             "{tree} sun -ab 1: oracle {ta:.4} ± {ts:.4}, fenestra {oa:.4} ± {os:.4} ({:+.1}%)",
             100.0 * (oa / ta - 1.0)

@@ -1094,12 +1094,15 @@ fn t4_7_runs_in_bounded_memory() {
     );
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("reflection not averaged"), "{err}");
-    let mb: f64 = err
-        .lines()
-        .find_map(|l| l.split("peak resident memory ").nth(1))
-        .and_then(|v| v.trim_end_matches(" MB").parse().ok())
-        .expect("peak memory line");
-    assert!(mb < 100.0, "peak {mb} MB");
+    // the memory line exists where the system reports it (Linux)
+    if cfg!(target_os = "linux") {
+        let mb: f64 = err
+            .lines()
+            .find_map(|l| l.split("peak resident memory ").nth(1))
+            .and_then(|v| v.trim_end_matches(" MB").parse().ok())
+            .expect("peak memory line");
+        assert!(mb < 100.0, "peak {mb} MB");
+    }
     std::fs::write(dir.join("b7.xml"), &out.stdout).unwrap();
     let b = read_file(&dir.join("b7.xml")).unwrap();
     assert_eq!(b.blocks.len(), 4);

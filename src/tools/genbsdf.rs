@@ -286,13 +286,9 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         }
         let r = got.rays;
         eprintln!(
-            "{p}: {ndir} incident directions x {} samples in {:.2} s; rays traced: {} primary, {} shadow, {} indirect (ambient samples and below), {} specular/transmitted",
+            "{p}: {ndir} incident directions x {} samples in {:.2} s; rays traced: {r}",
             got.samples,
             started.elapsed().as_secs_f64(),
-            r.primary,
-            r.shadow,
-            r.indirect,
-            r.specular
         );
         if let Some(m) = fenestra_cli::peak_memory_line() {
             eprintln!("{p}: {m}");

@@ -67,11 +67,11 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                     }
                 }
                 "f" => {
-                    fmt = match h.word() {
-                        "a" => Fmt::Ascii,
-                        "f" => Fmt::Float,
-                        "d" => Fmt::Double,
-                        w => bail!("-f{w}: unknown output format (expected -fa, -ff or -fd)"),
+                    let w = h.word();
+                    let mut c = w.chars();
+                    fmt = match (c.next().and_then(Fmt::from_letter), c.next()) {
+                        (Some(f), None) => f,
+                        _ => bail!("-f{w}: unknown output format (expected -fa, -ff or -fd)"),
                     }
                 }
                 "s" => seed = h.int() as u64,

@@ -193,12 +193,8 @@ fn budget(tracer: &Tracer, errs: &[fenestra_illum::filter::SurfaceError], second
     }
     let r = tracer.ray_counts();
     eprintln!(
-        "{p}: {} surfaces in {seconds:.2} s; rays traced: {} primary, {} shadow, {} indirect (ambient samples and below), {} specular/transmitted",
+        "{p}: {} surfaces in {seconds:.2} s; rays traced: {r}",
         errs.len(),
-        r.primary,
-        r.shadow,
-        r.indirect,
-        r.specular
     );
     if let Some(m) = fenestra_cli::peak_memory_line() {
         eprintln!("{p}: {m}");

@@ -208,16 +208,13 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         header: Some(info),
         ..Default::default()
     };
-    let mut head = String::from_utf8(fenestra_formats::matrix::header_bytes(
-        Some(yres),
-        xres,
-        3,
-        &opts,
-        &[],
-    )?)
-    .context("header text")?;
+    let mut head = fenestra_formats::matrix::header_bytes(Some(yres), xres, 3, &opts, &[])?;
     if !float_out {
-        head.push_str(&fenestra_formats::resolution::Resolution::standard(xres, yres).to_string());
+        head.extend_from_slice(
+            fenestra_formats::resolution::Resolution::standard(xres, yres)
+                .to_string()
+                .as_bytes(),
+        );
     }
 
     let data: Arc<Vec<ExprInput>> = Arc::new(
@@ -244,7 +241,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     };
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::with_capacity(1 << 16, stdout.lock());
-    out.write_all(head.as_bytes())?;
+    out.write_all(&head)?;
     let mut row = vec![[0f32; 3]; xres];
     let mut scan = vec![[0u8; 4]; xres];
     let mut fbuf = Vec::with_capacity(xres * 12);

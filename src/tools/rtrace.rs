@@ -382,13 +382,9 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     if verbose {
         let c = tracer.ray_counts();
         eprintln!(
-            "{}: {} rays traced for {k0} input records: {} primary, {} shadow, {} indirect (ambient samples and below), {} specular/transmitted",
+            "{}: {} rays traced for {k0} input records: {c}",
             fenestra_cli::prog(),
             tracer.rays_traced(),
-            c.primary,
-            c.shadow,
-            c.indirect,
-            c.specular
         );
         if let Some(m) = fenestra_cli::peak_memory_line() {
             eprintln!("{}: {m}", fenestra_cli::prog());

@@ -79,11 +79,11 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 "pd" => set.pd = h.real(),
                 "c" => set.repeat = h.int(),
                 "f" => {
-                    set.fmt = match h.word() {
-                        "a" => Fmt::Ascii,
-                        "f" => Fmt::Float,
-                        "d" => Fmt::Double,
-                        w => bail!("unknown output format '-f{w}' (expected -fa, -ff or -fd)"),
+                    let w = h.word();
+                    let mut c = w.chars();
+                    set.fmt = match (c.next().and_then(Fmt::from_letter), c.next()) {
+                        (Some(f), None) => f,
+                        _ => bail!("unknown output format '-f{w}' (expected -fa, -ff or -fd)"),
                     }
                 }
                 "i" => from_stdin = true,

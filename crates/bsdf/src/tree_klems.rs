@@ -16,7 +16,7 @@ use crate::radiance::RgbMatrix;
 use crate::tree_render::{Lobe, TreeBsdf};
 
 /// Binned slices by their shared identity.
-type Binned = Mutex<HashMap<(usize, bool), Arc<Vec<f64>>>>;
+type Binned = Mutex<HashMap<crate::tree_render::SliceKey, Arc<Vec<f64>>>>;
 
 /// The Klems transmission matrix (`basis` × `basis`, grey) of `tree`: 16 × 16 views per
 /// patch, leaves spread at 1/256 of the concentric square (converged to 1e-4 on a blind's
@@ -37,6 +37,10 @@ pub fn transmission_with(tree: &TreeBsdf, basis: &KlemsBasis, s: usize, h: f64) 
     let n = basis.len();
     let s = s.max(1);
     let lam = basis.lambdas();
+    // patch centres (for slices that cannot be binned)
+    let centres: Vec<Option<[f64; 3]>> = (0..n)
+        .map(|i| basis.sample_projected(i, 0.5, 0.5))
+        .collect();
     let lamb = tree.lambertian(Lobe::Transmission, true) / std::f64::consts::PI;
     // a slice's points binned by the patch of the way their light travels (each binned once
     // per shared slice; computed on whichever thread needs it first, the same numbers either way)
@@ -86,7 +90,7 @@ pub fn transmission_with(tree: &TreeBsdf, basis: &KlemsBasis, s: usize, h: f64) 
                     None => {
                         // no slice (a rank-3 tree used in reverse): the BSDF at patch centres
                         for (i, x) in row.iter_mut().enumerate() {
-                            if let Some(b) = basis.sample_projected(i, 0.5, 0.5) {
+                            if let Some(b) = centres[i] {
                                 let l = [-b[0], -b[1], -b[2]];
                                 *x += w * tree.eval(Lobe::Transmission, true, *v, l).0 * lam[i];
                             }

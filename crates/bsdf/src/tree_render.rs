@@ -62,7 +62,9 @@ fn uv_rgb(u: f64, v: f64) -> [f64; 3] {
         return [1.0; 3];
     }
     let xyz = [x / y, 1.0, (1.0 - x - y) / y];
-    let m = crate::radiance::xyz_to_rgb_matrix();
+    // the matrix once per process, not per leaf looked up (the same numbers)
+    static M: std::sync::OnceLock<[[f64; 3]; 3]> = std::sync::OnceLock::new();
+    let m = M.get_or_init(crate::radiance::xyz_to_rgb_matrix);
     let rgb = [0, 1, 2].map(|r| m[r][0] * xyz[0] + m[r][1] * xyz[1] + m[r][2] * xyz[2]);
     crate::radiance::clip_gamut(rgb, 1.0)
 }
@@ -78,7 +80,7 @@ struct Cells {
 }
 
 /// A slice's cache key: component, whether it is used in its own direction, incident cell.
-type SliceKey = (usize, bool, u32, u32);
+pub type SliceKey = (usize, bool, u32, u32);
 
 /// Most slices kept per BSDF (each a few kilobytes): memory stays bounded whatever the
 /// tree's resolution; slices past the limit are computed each time.
@@ -153,6 +155,10 @@ impl TreeBsdf {
         for &k in candidates(lobe, front) {
             let Some(c) = &self.comps[k] else { continue };
             if let Some((i, o)) = orient(c.side, v, l) {
+                if c.uv.is_none() {
+                    // a grey component: no tree position to work out
+                    return [1.0; 3];
+                }
                 return c.colour_at(&position(c.rank, i, o));
             }
         }
@@ -210,6 +216,7 @@ impl TreeBsdf {
             theta: 0.0,
             reverse: !own,
             sign: if own { out_sign } else { -out_sign },
+            key: (k, own, 0, 0),
         };
         let mut fixed = [0.0; 4];
         let mask: u32;
@@ -242,6 +249,7 @@ impl TreeBsdf {
             q(fixed[fixed_dims[0]]),
             fixed_dims.get(1).map_or(0, |&d| q(fixed[d])),
         );
+        s.key = key;
         let cached = self.cache.lock().ok().and_then(|m| m.get(&key).cloned());
         let cells = match cached {
             Some(cells) => cells,
@@ -354,6 +362,8 @@ pub struct Slice {
     theta: f64,
     reverse: bool,
     sign: f64,
+    /// The cache key: views with the same key share this slice.
+    key: SliceKey,
 }
 
 impl Slice {
@@ -395,8 +405,10 @@ impl Slice {
 
     /// An identity shared by every view whose slice spreads to the same directions (rank-4
     /// trees: views in the same finest cell); `None` for rank 3 (the slice turns with the view).
-    pub fn shared_id(&self) -> Option<(usize, bool)> {
-        (self.rank == 4).then_some((Arc::as_ptr(&self.cells) as usize, self.reverse))
+    pub fn shared_id(&self) -> Option<SliceKey> {
+        // the key, not the cells' address: an address can be reused once the cache is
+        // full and an uncached slice is freed
+        (self.rank == 4).then_some(self.key)
     }
 
     /// A direction drawn in proportion to value × projected solid angle: `x` picks the

@@ -54,8 +54,8 @@ impl Budget {
             .map(|n| format!("effect: {n}"))
             .collect();
         out.push(format!(
-            "{} records in {seconds:.2} s; rays traced: {} primary, {} shadow, {} indirect (ambient samples and below), {} specular/transmitted",
-            self.records, rays.primary, rays.shadow, rays.indirect, rays.specular
+            "{} records in {seconds:.2} s; rays traced: {rays}",
+            self.records
         ));
         for (k, name) in names.iter().enumerate() {
             let total = self.totals.get(k).copied().unwrap_or(0.0);

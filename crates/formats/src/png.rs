@@ -3,18 +3,23 @@
 
 /// CRC-32 (ISO 3309, as PNG uses) of `data`.
 pub fn crc32(data: &[u8]) -> u32 {
-    let mut table = [0u32; 256];
-    for (n, t) in table.iter_mut().enumerate() {
-        let mut c = n as u32;
-        for _ in 0..8 {
-            c = if c & 1 != 0 {
-                0xedb8_8320 ^ (c >> 1)
-            } else {
-                c >> 1
-            };
+    // the table once per process
+    static TABLE: std::sync::OnceLock<[u32; 256]> = std::sync::OnceLock::new();
+    let table = TABLE.get_or_init(|| {
+        let mut table = [0u32; 256];
+        for (n, t) in table.iter_mut().enumerate() {
+            let mut c = n as u32;
+            for _ in 0..8 {
+                c = if c & 1 != 0 {
+                    0xedb8_8320 ^ (c >> 1)
+                } else {
+                    c >> 1
+                };
+            }
+            *t = c;
         }
-        *t = c;
-    }
+        table
+    });
     let mut c = 0xffff_ffffu32;
     for &b in data {
         c = table[((c ^ u32::from(b)) & 0xff) as usize] ^ (c >> 8);
@@ -37,11 +42,12 @@ fn adler32(data: &[u8]) -> u32 {
 
 fn chunk(out: &mut Vec<u8>, kind: &[u8; 4], data: &[u8]) {
     out.extend_from_slice(&(data.len() as u32).to_be_bytes());
-    let mut body = Vec::with_capacity(4 + data.len());
-    body.extend_from_slice(kind);
-    body.extend_from_slice(data);
-    out.extend_from_slice(&body);
-    out.extend_from_slice(&crc32(&body).to_be_bytes());
+    // the CRC covers the kind and the data, as written (no copy of the data)
+    let start = out.len();
+    out.extend_from_slice(kind);
+    out.extend_from_slice(data);
+    let crc = crc32(&out[start..]);
+    out.extend_from_slice(&crc.to_be_bytes());
 }
 
 /// A PNG file of `width` × `height` RGB pixels, rows from the top.

@@ -314,25 +314,35 @@ impl Settings {
 
     /// The numbers of altitude and azimuth divisions of a hemisphere (1 × 1 when diffuse).
     pub fn flat_divisions(&self) -> (usize, usize) {
-        if self.sampdens <= 0 {
-            return (1, 1);
-        }
-        let n = (std::f64::consts::PI * self.sampdens as f64) as i64;
-        let nalt = ((n as f64 / std::f64::consts::PI).sqrt() + 0.5) as i64;
-        let nazi = (std::f64::consts::PI * nalt as f64 + 0.5) as i64;
-        (nalt.max(1) as usize, nazi.max(1) as usize)
+        flat_divisions(self.sampdens)
     }
 
     /// The same for a whole sphere.
     pub fn round_divisions(&self) -> (usize, usize) {
-        if self.sampdens <= 0 {
-            return (1, 1);
-        }
-        let n = (4.0 * std::f64::consts::PI * self.sampdens as f64) as i64;
-        let nalt = ((2.0 / std::f64::consts::PI * n as f64).sqrt() + 0.5) as i64;
-        let nazi = (std::f64::consts::PI / 2.0 * nalt as f64 + 0.5) as i64;
-        (nalt.max(1) as usize, nazi.max(1) as usize)
+        round_divisions(self.sampdens)
     }
+}
+
+/// Altitude and azimuth divisions of a hemisphere at `d=dens` (1 × 1 when diffuse).
+pub fn flat_divisions(dens: i64) -> (usize, usize) {
+    if dens <= 0 {
+        return (1, 1);
+    }
+    let n = (std::f64::consts::PI * dens as f64) as i64;
+    let nalt = ((n as f64 / std::f64::consts::PI).sqrt() + 0.5) as i64;
+    let nazi = (std::f64::consts::PI * nalt as f64 + 0.5) as i64;
+    (nalt.max(1) as usize, nazi.max(1) as usize)
+}
+
+/// The same for a whole sphere.
+pub fn round_divisions(dens: i64) -> (usize, usize) {
+    if dens <= 0 {
+        return (1, 1);
+    }
+    let n = (4.0 * std::f64::consts::PI * dens as f64) as i64;
+    let nalt = ((2.0 / std::f64::consts::PI * n as f64).sqrt() + 0.5) as i64;
+    let nazi = (std::f64::consts::PI / 2.0 * nalt as f64 + 0.5) as i64;
+    (nalt.max(1) as usize, nazi.max(1) as usize)
 }
 
 #[cfg(test)]

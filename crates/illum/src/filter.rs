@@ -310,6 +310,8 @@ impl<'a> Filter<'a> {
     }
 
     fn convert(&mut self, p: &Prim, name: &str, out: &mut String) -> Result<()> {
+        // one number per surface (it keys the surface's random streams), refined or not
+        self.surfaces += 1;
         let bsdf = self
             .settings
             .bsdf
@@ -317,19 +319,21 @@ impl<'a> Filter<'a> {
             .and_then(|f| self.bsdfs.get(f))
             .cloned();
         if let Some(data) = bsdf {
-            let job = self.job(p, self.settings.sampdens);
+            let job = self.job(p, self.settings.sampdens, Some(data.incident.len()));
             return self.convert_bsdf(p, name, out, &job, &data);
         }
         let keep = self.settings.sampdens;
         let mut dens = keep;
-        let result = loop {
-            let job = self.job(p, dens);
+        let (dist, axes, peak) = loop {
+            let job = self.job(p, dens, None);
             let Some((dist, axes)) = self.sample_traced(p, name, out, &job)? else {
                 return Ok(());
             };
-            // p+: a peak in one cell: the surface again at 4× the density (at most d=4096)
+            let peak = if dens > 0 { dist.peak() } else { None };
+            // p+: a peak in one cell: the surface again at 4× the density, while that
+            // stays within d=4096
             let refine = self.settings.refine && dens > 0 && dens * 4 <= 4096;
-            match dist.peak() {
+            match peak {
                 Some(share) if refine => {
                     warn(format!(
                         "{} \"{}\": one of its {} directions carries {:.0}% of the light at d={dens}: sampled again at d={} (p+)",
@@ -341,27 +345,24 @@ impl<'a> Filter<'a> {
                     ));
                     dens *= 4;
                 }
-                _ => break (dist, axes),
+                _ => break (dist, axes, peak),
             }
         };
         // the distribution is written at the density used
         self.settings.sampdens = dens;
-        let r = self.finish_surface(p, out, result.0, result.1);
+        let r = self.finish_surface(p, out, dist, axes, peak);
         self.settings.sampdens = keep;
         r
     }
 
-    /// The sampling job of surface `p` at density `dens` (counts the surface).
-    fn job(&mut self, p: &Prim, dens: i64) -> Job<'a> {
-        let il = &self.settings;
-        let mut at = il.clone();
-        at.sampdens = dens;
+    /// The sampling job of surface number `self.surfaces` (`p`) at density `dens`;
+    /// `bsdf_patches`: the incident patches of the BSDF-data mode (for the progress bar).
+    fn job(&self, p: &Prim, dens: i64, bsdf_patches: Option<usize>) -> Job<'a> {
         let (nalt, nazi) = match p.ptype.as_str() {
-            "sphere" => at.round_divisions(),
-            _ => at.flat_divisions(),
+            "sphere" => crate::directives::round_divisions(dens),
+            _ => crate::directives::flat_divisions(dens),
         };
-        let nsamps = il.nsamps.max(1) as usize;
-        self.surfaces += 1;
+        let nsamps = self.settings.nsamps.max(1) as usize;
         let job = Job {
             tracer: self.tracer,
             seed: self.seed,
@@ -369,19 +370,13 @@ impl<'a> Filter<'a> {
             nalt,
             nazi,
             nsamps,
-            light: il.light,
+            light: self.settings.light,
             progress: self.progress,
         };
         if let Some(pr) = self.progress {
-            let bsdf_patches = il
-                .bsdf
-                .as_ref()
-                .and_then(|f| self.bsdfs.get(f))
-                .map(|d| d.incident.len());
-            let rays = if let Some(np) = bsdf_patches {
-                np * nsamps
-            } else {
-                nalt * nazi * nsamps
+            let rays = match bsdf_patches {
+                Some(np) => np * nsamps,
+                None => nalt * nazi * nsamps,
             };
             pr.restart(rays as u64, &format!("mkillum {}", p.name));
         }
@@ -476,7 +471,8 @@ impl<'a> Filter<'a> {
         // the distribution is always written, whatever d= was before
         let keep = self.settings.sampdens;
         self.settings.sampdens = self.settings.sampdens.max(1);
-        let r = self.finish_surface(p, out, dist, Some(axes));
+        let peak = dist.peak();
+        let r = self.finish_surface(p, out, dist, Some(axes), peak);
         self.settings.sampdens = keep;
         r
     }
@@ -489,6 +485,7 @@ impl<'a> Filter<'a> {
         out: &mut String,
         dist: crate::sample::Distribution,
         axes: Option<[glam::DVec3; 3]>,
+        peak: Option<f64>,
     ) -> Result<()> {
         let col = dist.average();
         if crate::bright(col) <= self.settings.minbrt + 1e-6 {
@@ -504,7 +501,7 @@ impl<'a> Filter<'a> {
             });
         }
         if self.settings.sampdens > 0 {
-            if let Some(share) = dist.peak() {
+            if let Some(share) = peak {
                 // Radiance spreads such a peak over its cell without a word
                 warn(format!(
                     "{} \"{}\": one of its {} directions carries {:.0}% of the light leaving it (a peak, as of a sun by way of specular surfaces), spread here over a cell of {:.3} sr (projected); raise d= (now {}), give p+ (fenestra: sampled again finer) or sample the source with l+",

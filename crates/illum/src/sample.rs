@@ -65,15 +65,14 @@ impl Distribution {
     /// brightest bin, when that bin holds more than a quarter of it and is over 20 times the
     /// median bin (a sun seen by way of specular surfaces, which a cell spreads out).
     pub fn peak(&self) -> Option<f64> {
-        let lum: Vec<f64> = self.sums.iter().map(|v| crate::bright(*v)).collect();
+        let mut lum: Vec<f64> = self.sums.iter().map(|v| crate::bright(*v)).collect();
         let total: f64 = lum.iter().sum();
         if lum.len() < 4 || total.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return None;
         }
         let max = lum.iter().copied().fold(0.0f64, f64::max);
-        let mut sorted = lum.clone();
-        sorted.sort_by(f64::total_cmp);
-        let median = sorted[sorted.len() / 2];
+        let mid = lum.len() / 2;
+        let median = *lum.select_nth_unstable_by(mid, f64::total_cmp).1;
         let share = max / total;
         (share > 0.25 && max > 20.0 * median).then_some(share)
     }

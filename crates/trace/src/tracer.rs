@@ -248,6 +248,17 @@ pub struct RayCounts {
     pub specular: u64,
 }
 
+impl std::fmt::Display for RayCounts {
+    /// `N primary, N shadow, N indirect (ambient samples and below), N specular/transmitted`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} primary, {} shadow, {} indirect (ambient samples and below), {} specular/transmitted",
+            self.primary, self.shadow, self.indirect, self.specular
+        )
+    }
+}
+
 /// What the integrator switched on, and why (printed by `-v`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Effects {

@@ -65,7 +65,6 @@ impl WriteOptions {
     }
 }
 
-/// Writes a matrix row by row.
 /// The header every fenestra tool writes before matrix (or picture) data: the information
 /// lines (`#?RADIANCE` first if missing), then for a matrix `NROWS` (unless not asked or
 /// unknown), `NCOLS`, the lines `after_ncols` (gendaymtx's `NAVERAGED`), `NCOMP`; then
@@ -114,6 +113,7 @@ pub fn header_bytes(
     Ok(text)
 }
 
+/// Writes a matrix row by row.
 pub struct MatrixWriter<W: Write> {
     w: W,
     format: DataFormat,
