@@ -54,8 +54,8 @@ pub struct Settings {
     pub bsdf: Option<String>,
     /// `u=`: the BSDF's up vector (fenestra; default +Z, or +Y for a window facing up or down).
     pub up: Option<glam::DVec3>,
-    /// `p+`: a distribution with a peak in one cell is sampled again at 4× the density, up
-    /// to twice (fenestra; `p-`, the default, only warns).
+    /// `p+`: a distribution with a peak in one cell is sampled again at 4× the density, while
+    /// that stays within d=4096 (fenestra; `p-`, the default, only warns).
     pub refine: bool,
 }
 
