@@ -163,6 +163,23 @@ impl LobeData<'_> {
         }
     }
 
+    /// [`Self::eval_sized`] with the colour of [`Self::colour`] (a Klems cell looked up
+    /// once; a tree's colour only where the value is positive, grey elsewhere).
+    pub fn eval_full(&self, v: DVec3, l: DVec3) -> (f64, f64, DVec3) {
+        match self {
+            LobeData::Klems(c) => c.eval_full(v, l),
+            LobeData::Tree(..) => {
+                let (f, size) = self.eval_sized(v, l);
+                let colour = if f > 0.0 {
+                    self.colour(v, l)
+                } else {
+                    DVec3::ONE
+                };
+                (f, size, colour)
+            }
+        }
+    }
+
     /// Projected solid angle of the lobe's smallest cell (Radiance's `minProjSA`).
     pub fn min_size(&self) -> f64 {
         match self {
@@ -319,6 +336,22 @@ impl Component {
     /// Outgoing index of a light vector `l` (local, pointing away from the surface).
     fn out_index(&self, l: DVec3) -> Option<usize> {
         self.m.outgoing.patch(flip(l, false, self.out_back))
+    }
+
+    /// BSDF value (sr⁻¹), jitter size (the smaller projected solid angle of the two
+    /// patches) and colour for view `v` and light `l`, each patch looked up once; zeros
+    /// and a grey colour outside the bases.
+    pub fn eval_full(&self, v: DVec3, l: DVec3) -> (f64, f64, DVec3) {
+        let (Some(i), Some(o)) = (self.in_index(v), self.out_index(l)) else {
+            return (0.0, 0.0, DVec3::ONE);
+        };
+        let size = self
+            .m
+            .incident
+            .projected_solid_angle(i)
+            .zip(self.m.outgoing.projected_solid_angle(o))
+            .map_or(0.0, |(a, b)| a.min(b));
+        (self.m.get(o, i).max(0.0), size, self.colour_at(o, i))
     }
 
     /// BSDF value (sr⁻¹) for view `v` and light `l`.

@@ -20,6 +20,7 @@ use crate::rng::Rng;
 use crate::shape::Shape;
 
 mod ambient;
+use ambient::{frame, square_to_disk};
 mod compile;
 mod cylinder;
 mod direct;
@@ -34,7 +35,6 @@ use direct::{Aim, Lit};
 use shade_normal::NormalLobes;
 mod threshold;
 
-use ambient::frame;
 pub use query::{FirstHit, SourceLight};
 
 /// Most parts of a flat or cylinder source under `-ds` (Radiance's MAXSPART).
@@ -229,6 +229,8 @@ struct Distant {
     prim: usize,
     mat: usize,
     dir: DVec3,
+    /// Two unit vectors completing `dir` to an orthonormal frame (for `-dj`).
+    frame: (DVec3, DVec3),
     cos_half: f64,
     omega: f64,
     glow: bool,

@@ -92,6 +92,7 @@ impl Tracer {
                         prim: i,
                         mat: m,
                         dir,
+                        frame: frame(dir),
                         cos_half,
                         omega: 2.0 * PI * (1.0 - cos_half),
                         glow,

@@ -93,7 +93,7 @@ impl Tracer {
         match s.geom {
             SourceGeom::Distant(k) => {
                 let d = &self.distant[k];
-                let l = self.jitter_cone(d.dir, d.cos_half, cx);
+                let l = self.jitter_cone(d.dir, d.frame, d.cos_half, cx);
                 f(
                     cx,
                     SourceSample {
@@ -112,7 +112,7 @@ impl Tracer {
                     return;
                 };
                 let d = &self.distant[k];
-                let l = self.jitter_cone(dir, d.cos_half, cx);
+                let l = self.jitter_cone(dir, frame(dir), d.cos_half, cx);
                 f(
                     cx,
                     SourceSample {
@@ -219,18 +219,21 @@ impl Tracer {
         }
     }
 
-    /// A direction toward a distant source: its centre, or with `-dj` a point jittered
-    /// within the source's cone.
-    pub(super) fn jitter_cone(&self, dir: DVec3, cos_half: f64, cx: &mut Ctx) -> DVec3 {
+    /// A direction toward a distant source: its centre, or with `-dj` a point drawn
+    /// uniformly (by solid angle) within the fraction `-dj` of the source's cone
+    /// ([`cone_direction`]); `frame` completes `dir` to an orthonormal basis.
+    pub(super) fn jitter_cone(
+        &self,
+        dir: DVec3,
+        frame: (DVec3, DVec3),
+        cos_half: f64,
+        cx: &mut Ctx,
+    ) -> DVec3 {
         if self.opts.dj <= 0.0 {
             return dir;
         }
         let (u, v) = (cx.rng.next_f64(), cx.rng.next_f64());
-        let ct = 1.0 - self.opts.dj * u * (1.0 - cos_half);
-        let st = (1.0 - ct * ct).max(0.0).sqrt();
-        let (a, b) = frame(dir);
-        let ph = 2.0 * PI * v;
-        (a * (st * ph.cos()) + b * (st * ph.sin()) + dir * ct).normalize()
+        cone_direction(dir, frame, self.opts.dj * (1.0 - cos_half), u, v)
     }
 
     /// A shadow ray meeting a mirror: if it is aimed at that mirror's image of a distant
@@ -306,5 +309,56 @@ impl Tracer {
             return None;
         }
         Some(2.0 * PI * (1.0 - (1.0 - r * r / d2).max(0.0).sqrt()))
+    }
+}
+
+/// The direction of a cap about unit `dir` (frame `a`, `b`) of solid angle 2π·`k` for the
+/// unit-square point (`u`, `v`), uniform by solid angle. The point (x, y) of the unit disk
+/// (concentric map) gives the angle from the axis, 1 − cos θ = w = k·r² (r² = x² + y² is
+/// uniform), and the azimuth; sin θ / r = √(k·(2 − w)), so neither a trigonometric call nor
+/// a division is needed, and the result is unit to within rounding.
+pub(super) fn cone_direction(dir: DVec3, (a, b): (DVec3, DVec3), k: f64, u: f64, v: f64) -> DVec3 {
+    let (x, y) = square_to_disk(u, v);
+    let w = k * (x * x + y * y);
+    let s = (k * (2.0 - w)).max(0.0).sqrt();
+    (a * x + b * y) * s + dir * (1.0 - w)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cone_directions_are_unit_and_uniform_by_solid_angle() {
+        let dir = DVec3::new(0.3, -0.5, 0.8).normalize();
+        let f = frame(dir);
+        // the sun's cone (0.5° across) and a wide one
+        for k in [1.0 - (0.25f64).to_radians().cos(), 0.3] {
+            let n = 256;
+            let (mut sum_w, mut sum_a, mut sum_b) = (0.0, 0.0, 0.0);
+            for i in 0..n {
+                for j in 0..n {
+                    let (u, v) = ((i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64);
+                    let d = cone_direction(dir, f, k, u, v);
+                    assert!((d.length() - 1.0).abs() < 1e-15, "{}", d.length());
+                    let w = 1.0 - d.dot(dir);
+                    assert!(w >= -1e-15 && w <= k * (1.0 + 1e-12), "{w} beyond {k}");
+                    sum_w += w;
+                    sum_a += d.dot(f.0);
+                    sum_b += d.dot(f.1);
+                }
+            }
+            let m = (n * n) as f64;
+            // uniform by solid angle: 1 − cos θ uniform on [0, k], mean k/2 (the grid's
+            // midpoints give it to ~1/n²); azimuth symmetric: the frame components cancel
+            assert!(
+                (sum_w / m - k / 2.0).abs() < 1e-4 * k,
+                "{} vs {}",
+                sum_w / m,
+                k / 2.0
+            );
+            let sin_max = (k * (2.0 - k)).sqrt();
+            assert!((sum_a / m).abs() < 1e-3 * sin_max && (sum_b / m).abs() < 1e-3 * sin_max);
+        }
     }
 }

@@ -191,10 +191,10 @@ impl Tracer {
         // (a coloured file: each view's value carries its element's colour; the result is
         // the luminance so found in the mean colour of the views counted)
         let remainder = |c: &LobeData, ll: DVec3, diff_y: f64| -> DVec3 {
-            let (f0, tomega) = c.eval_sized(v, ll);
+            let (f0, tomega, colour0) = c.eval_full(v, ll);
             let radius = tomega.max(0.0).sqrt() * shrink;
             if radius <= 0.0 {
-                return f0 * c.colour(v, ll);
+                return f0 * colour0;
             }
             let mut g = jit.borrow_mut();
             let (mut sum, mut count) = (0.0, 0usize);
@@ -202,7 +202,7 @@ impl Tracer {
             for _ in 0..nview {
                 let (u, w) = (g.next_f64(), g.next_f64());
                 let vj = jitter(v, radius, u, w);
-                let (f, size) = c.eval_sized(vj, ll);
+                let (f, size, colour) = c.eval_full(vj, ll);
                 if f <= FTINY {
                     count += 1;
                     continue;
@@ -211,7 +211,7 @@ impl Tracer {
                     continue;
                 }
                 sum += f + diff_y;
-                sum_c += f * c.colour(vj, ll);
+                sum_c += f * colour;
                 sum_f += f;
                 count += 1;
             }
