@@ -213,6 +213,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
 /// A matrix file as a planar matrix.
 fn planar(name: &str) -> Result<fenestra_dc::timestep::Planar> {
     let m = fenestra_formats::matrix::Matrix::read(name)?;
+    fenestra_cli::warn_all(m.notes.clone());
     fenestra_dc::timestep::Planar::from_interleaved(m.nrows, m.ncols, m.ncomp, &m.data)
         .map_err(|e| anyhow::anyhow!("{name}: {e:#}"))
 }
@@ -229,6 +230,7 @@ struct ErrorInputs<'a> {
 fn uncertainty(se: Option<&str>, rep: Option<&str>) -> Result<Uncertainty> {
     if let Some(name) = rep {
         let m = fenestra_formats::matrix::Matrix::read(name)?;
+        fenestra_cli::warn_all(m.notes.clone());
         let k: usize = match m.header.get("NREPLICAS") {
             Some(v) => v.trim().parse().map_err(|_| {
                 anyhow::anyhow!("{name}: NREPLICAS={v} is not a number of replicas")

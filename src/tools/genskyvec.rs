@@ -119,9 +119,16 @@ fn sky_function(p: &Prim) -> Result<Box<dyn Fn([f64; 3]) -> f64 + Sync>> {
             // Any other sky function: through the .cal engine, as Radiance's genskyvec
             // has rtrace evaluate it (rayinit.cal first; a distant glow: N = -D).
             let cal = p.sargs[1].clone();
-            let pat =
-                fenestra_trace::pattern::CalPattern::new(&[func], &cal, &a, None, &p.name, &[])
-                    .with_context(|| format!("skyfunc '{}' ({cal})", p.name))?;
+            let pat = fenestra_trace::pattern::CalPattern::new(
+                &[func],
+                &cal,
+                &a,
+                None,
+                &p.name,
+                &[],
+                &fenestra_cli::raypath::Resolver::from_env(),
+            )
+            .with_context(|| format!("skyfunc '{}' ({cal})", p.name))?;
             Ok(Box::new(move |d| {
                 let dir = glam::DVec3::from_array(d);
                 let q = fenestra_trace::pattern::PatternInput {

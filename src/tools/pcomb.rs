@@ -304,8 +304,9 @@ fn parse_res(w: &str, axis: &str, sources: &[Source], xmax: usize, ymax: usize) 
     p.set_number("xmax", xmax as f64);
     p.set_number("ymax", ymax as f64);
     p.set_number("PI", std::f64::consts::PI);
+    let resolver = fenestra_cli::raypath::Resolver::from_env();
     for s in sources {
-        s.load(&mut p)?;
+        s.load(&mut p, &resolver)?;
     }
     let e = p
         .add_expr(&format!("-{axis}"), w)

@@ -128,8 +128,9 @@ impl Exprs {
                 }),
             );
         }
+        let resolver = fenestra_cli::raypath::Resolver::from_env();
         for s in sources {
-            s.load(&mut p)?;
+            s.load(&mut p, &resolver)?;
         }
         let xy = p.bind_vars(&["x", "y"]);
         let exe = p.compile().map_err(|e| anyhow!("{e}"))?;

@@ -354,6 +354,7 @@ fn load_tracked(inp: &Input, verbose: bool) -> Result<Tracked> {
                 bail!("{name}: replicas are a matrix file (rtcontrib -E -Er K), not a BSDF");
             }
             let raw = fenestra_formats::matrix::Matrix::read(name)?;
+            fenestra_cli::warn_all(raw.notes.clone());
             let k: usize = match raw.header.get("NREPLICAS").map(|v| v.trim().parse()) {
                 Some(Ok(k)) => k,
                 _ => bail!("{name}: no NREPLICAS= line: not a replica file of rtcontrib -Er"),

@@ -48,6 +48,7 @@ pub struct StepOptions {
 pub fn load_td(tname: &str, dname: &str) -> Result<(Planar, usize)> {
     let t = load_t(tname)?;
     let d = Matrix::read(dname)?;
+    fenestra_cli::warn_all(d.notes.clone());
     if d.nrows != t.cols {
         bail!(
             "{dname} has {} rows, but T ({tname}) has {} columns: the daylight matrix must have one row per column of T",
@@ -77,6 +78,7 @@ pub fn load_t(name: &str) -> Result<Planar> {
         return Ok(p);
     }
     let m = Matrix::read(name)?;
+    fenestra_cli::warn_all(m.notes.clone());
     Planar::from_interleaved(m.nrows, m.ncols, m.ncomp, &m.data).with_context(|| name.to_string())
 }
 
@@ -165,6 +167,7 @@ pub fn read_sky(
             s
         }
     };
+    fenestra_cli::warn_all(r.take_notes());
     if o.nsteps.is_none() && r.has_trailing_data() {
         fenestra_cli::warn(format!("{shown}: data beyond the sky matrix ignored"));
     }
@@ -392,6 +395,7 @@ impl VRows {
                 all.extend_from_slice(&row);
                 n += 1;
             }
+            fenestra_cli::warn_all(reader.take_notes());
             reader.info.nrows = Some(n);
             held = Some((all, 0));
         }
@@ -417,6 +421,7 @@ impl VRows {
         while n < max && self.reader.read_row(&mut buf[n * len..(n + 1) * len])? {
             n += 1;
         }
+        fenestra_cli::warn_all(self.reader.take_notes());
         buf.truncate(n * len);
         Ok(n)
     }

@@ -29,6 +29,13 @@ pub fn prog() -> &'static str {
     PROG.get().map(String::as_str).unwrap_or("fenestra")
 }
 
+/// Prints each of `notes` (warnings a library returned) as [`warn`] does.
+pub fn warn_all(notes: impl IntoIterator<Item = String>) {
+    for n in notes {
+        warn(n);
+    }
+}
+
 /// Prints `prog: warning - msg` on stderr, as Radiance tools do.
 pub fn warn(msg: impl std::fmt::Display) {
     if !WARNINGS.load(std::sync::atomic::Ordering::Relaxed) {

@@ -11,4 +11,4 @@ pub mod input;
 pub mod output;
 pub mod raypath;
 
-pub use diag::{prog, set_prog, set_warnings, warn, warnings_on};
+pub use diag::{prog, set_prog, set_warnings, warn, warn_all, warnings_on};

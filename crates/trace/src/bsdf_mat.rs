@@ -14,6 +14,7 @@ use std::sync::Arc;
 use anyhow::{bail, Context, Result};
 use fenestra_bsdf::tree_render::{Lobe, TreeBsdf};
 use fenestra_bsdf::{Direction, KlemsMatrix, Wavelength};
+use fenestra_io::raypath::Resolver;
 use fenestra_scene::Primitive;
 use glam::DVec3;
 
@@ -379,8 +380,9 @@ impl Component {
     }
 }
 
-/// Compiles a `BSDF` primitive: `6 thick file ux uy uz funcfile`, 0/3/6/9 reals.
-pub fn compile(p: &Primitive) -> Result<BsdfMat> {
+/// Compiles a `BSDF` primitive: `6 thick file ux uy uz funcfile`, 0/3/6/9 reals (the
+/// file found through `resolver`).
+pub fn compile(p: &Primitive, resolver: &Resolver) -> Result<BsdfMat> {
     // aBSDF has no thickness argument
     let through = p.ptype == "aBSDF";
     let o = usize::from(!through);
@@ -418,7 +420,8 @@ pub fn compile(p: &Primitive) -> Result<BsdfMat> {
             p.sargs[4 + o]
         );
     }
-    let path = fenestra_io::raypath::find_or_err(&p.sargs[o])
+    let path = resolver
+        .find_or_err(&p.sargs[o])
         .with_context(|| format!("{}: BSDF '{}'", p.loc, p.name))?;
     let b = fenestra_bsdf::read_file(&path)
         .map_err(|e| anyhow::anyhow!("{}: BSDF '{}': {e}", p.loc, p.name))?;

@@ -1,6 +1,7 @@
 //! Materials compiled from the scene: the arguments each shading routine needs.
 
 use anyhow::{bail, Result};
+use fenestra_io::raypath::Resolver;
 use fenestra_scene::{Primitive, Scene};
 use glam::DVec3;
 
@@ -118,8 +119,8 @@ pub fn is_pattern(ptype: &str) -> bool {
     )
 }
 
-/// Compiles material primitive `i` of `scene`.
-pub fn compile(scene: &Scene, i: usize) -> Result<Material> {
+/// Compiles material primitive `i` of `scene` (a BSDF file found through `resolver`).
+pub fn compile(scene: &Scene, i: usize, resolver: &Resolver) -> Result<Material> {
     let p = &scene.prims[i];
     Ok(match p.ptype.as_str() {
         "plastic" | "metal" => {
@@ -169,7 +170,7 @@ pub fn compile(scene: &Scene, i: usize) -> Result<Material> {
                 n: p.rargs[3],
             }
         }
-        "BSDF" | "aBSDF" => Material::Bsdf(Box::new(crate::bsdf_mat::compile(p)?)),
+        "BSDF" | "aBSDF" => Material::Bsdf(Box::new(crate::bsdf_mat::compile(p, resolver)?)),
         "light" => {
             need(p, 3)?;
             Material::Light {

@@ -1,5 +1,7 @@
 //! Rendering options shared by rtrace and rcontrib (`-ab -ad -lw -lr -ds -dj …`).
 
+use fenestra_io::raypath::Resolver;
+
 /// Options of the integrator (Radiance names in the field docs).
 #[derive(Debug, Clone, PartialEq)]
 pub struct TraceOptions {
@@ -41,6 +43,9 @@ pub struct TraceOptions {
     /// `-e expr` and `-f file.cal` in command-line order: loaded after `rayinit.cal` and
     /// before each pattern's own file, as Radiance's global calcomp context.
     pub cal: Vec<CalSource>,
+    /// Where the scene's auxiliary files (.cal, data, BSDF XML) and `-f` files are found
+    /// (by default `RAYPATH` and fenestra's library, read when the options are made).
+    pub resolver: Resolver,
 }
 
 /// A command-line .cal source (`-e` or `-f`).
@@ -53,12 +58,12 @@ pub enum CalSource {
 }
 
 impl CalSource {
-    /// Loads this source into a program.
-    pub fn load(&self, p: &mut fenestra_calc::Program) -> anyhow::Result<()> {
+    /// Loads this source into a program (a file found through `resolver`).
+    pub fn load(&self, p: &mut fenestra_calc::Program, resolver: &Resolver) -> anyhow::Result<()> {
         match self {
             CalSource::Expr(e) => p.load_str("-e", e).map_err(|e| anyhow::anyhow!("{e}")),
             CalSource::File(f) => {
-                let path = fenestra_io::raypath::find_or_err(f)?;
+                let path = resolver.find_or_err(f)?;
                 p.load_file(&path).map_err(|e| anyhow::anyhow!("{e}"))
             }
         }
@@ -86,6 +91,7 @@ impl TraceOptions {
             seed: 0,
             full: false,
             cal: Vec::new(),
+            resolver: Resolver::from_env(),
         }
     }
 

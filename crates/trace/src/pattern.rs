@@ -13,6 +13,7 @@ use fenestra_calc::{Compiled, ExprId, FuncId, Program, VarId};
 
 use crate::datafile::DataGrid;
 use crate::options::CalSource;
+use fenestra_io::raypath::Resolver;
 use fenestra_scene::Scene;
 use fenestra_sky::cie::SkyBright;
 use fenestra_sky::skyvec::PerezLum;
@@ -79,15 +80,15 @@ const TRIAL: PatternInput = PatternInput {
 
 /// A program with what every pattern sees first: `rayinit.cal`, then the command
 /// line's `-e`/`-f` sources, then the pattern's own file (`.` for none).
-fn program(user: &[CalSource], cal: &str) -> Result<Program> {
+fn program(user: &[CalSource], cal: &str, resolver: &Resolver) -> Result<Program> {
     let mut p = Program::for_renderer();
-    let init = fenestra_io::raypath::find_or_err("rayinit.cal")?;
+    let init = resolver.find_or_err("rayinit.cal")?;
     p.load_file(&init).map_err(|e| anyhow!("{e}"))?;
     for c in user {
-        c.load(&mut p)?;
+        c.load(&mut p, resolver)?;
     }
     if cal != "." {
-        let path = fenestra_io::raypath::find_or_err(cal)?;
+        let path = resolver.find_or_err(cal)?;
         p.load_file(&path).map_err(|e| anyhow!("{e}"))?;
     }
     Ok(p)
@@ -152,8 +153,9 @@ impl CalPattern {
         frame: Option<PatternFrame>,
         label: &str,
         user: &[CalSource],
+        resolver: &Resolver,
     ) -> Result<CalPattern> {
-        let mut p = program(user, cal)?;
+        let mut p = program(user, cal, resolver)?;
         let vars = p.bind_vars(&HOST_VARS);
         let mut ids = Vec::new();
         for e in exprs {
@@ -320,8 +322,14 @@ impl Pattern {
 }
 
 /// Compiles pattern primitive `k` (used by material `user` for messages).
-/// `cal` holds the command line's `-e`/`-f` definitions.
-pub fn compile(scene: &Scene, k: usize, user: &str, cal: &[CalSource]) -> Result<Pattern> {
+/// `cal` holds the command line's `-e`/`-f` definitions; files are found through `resolver`.
+pub fn compile(
+    scene: &Scene,
+    k: usize,
+    user: &str,
+    cal: &[CalSource],
+    resolver: &Resolver,
+) -> Result<Pattern> {
     let q = &scene.prims[k];
     let file = |s: &str| s.rsplit('/').next().unwrap_or(s).to_string();
     if q.ptype == "brightfunc" && q.sargs.len() == 2 {
@@ -339,7 +347,7 @@ pub fn compile(scene: &Scene, k: usize, user: &str, cal: &[CalSource]) -> Result
     }
     let what = format!("{}: {} '{}' (modifying '{user}')", q.loc, q.ptype, q.name);
     if q.ptype == "brightdata" || q.ptype == "colordata" {
-        return compile_data(q, &what, cal);
+        return compile_data(q, &what, cal, resolver);
     }
     let nexpr = match q.ptype.as_str() {
         "brightfunc" => 1,
@@ -363,20 +371,28 @@ pub fn compile(scene: &Scene, k: usize, user: &str, cal: &[CalSource]) -> Result
         frame,
         &q.name,
         cal,
+        resolver,
     )
     .map_err(|e| anyhow!("{what}: {e:#}"))?;
     Ok(Pattern::Cal(Arc::new(cp)))
 }
 
 /// `brightdata func data funcfile x1…xn` / `colordata rf gf bf rdata gdata bdata funcfile x1…xn`.
-fn compile_data(q: &fenestra_scene::Primitive, what: &str, user: &[CalSource]) -> Result<Pattern> {
+fn compile_data(
+    q: &fenestra_scene::Primitive,
+    what: &str,
+    user: &[CalSource],
+    resolver: &Resolver,
+) -> Result<Pattern> {
     let nf = if q.ptype == "brightdata" { 1 } else { 3 };
     if q.sargs.len() < 2 * nf + 1 {
         bail!("{what}: needs at least {} string arguments", 2 * nf + 1);
     }
     let mut grids = Vec::new();
     for name in &q.sargs[nf..2 * nf] {
-        let path = fenestra_io::raypath::find_or_err(name).map_err(|e| anyhow!("{what}: {e:#}"))?;
+        let path = resolver
+            .find_or_err(name)
+            .map_err(|e| anyhow!("{what}: {e:#}"))?;
         grids.push(DataGrid::read(&path).map_err(|e| anyhow!("{what}: {e:#}"))?);
     }
     let dims = grids[0].dims();
@@ -394,7 +410,9 @@ fn compile_data(q: &fenestra_scene::Primitive, what: &str, user: &[CalSource]) -
     let (coords, xf) = coords.split_at(dims);
     if xf.is_empty() && user.is_empty() {
         let text = |name: &str| {
-            fenestra_io::raypath::find(name).and_then(|p| std::fs::read_to_string(p).ok())
+            resolver
+                .find(name)
+                .and_then(|p| std::fs::read_to_string(p).ok())
         };
         if let (Some(c), Some(r)) = (text(cal), text("rayinit.cal")) {
             let nf = q.sargs[..nf].to_vec();
@@ -422,7 +440,7 @@ fn compile_data(q: &fenestra_scene::Primitive, what: &str, user: &[CalSource]) -
         }
     }
     let frame = PatternFrame::parse(xf).map_err(|e| anyhow!("{what}: {e:#}"))?;
-    let mut p = program(user, cal).map_err(|e| anyhow!("{what}: {e:#}"))?;
+    let mut p = program(user, cal, resolver).map_err(|e| anyhow!("{what}: {e:#}"))?;
     let vars = p.bind_vars(&HOST_VARS);
     let mut ids = Vec::new();
     for e in coords {

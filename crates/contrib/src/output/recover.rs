@@ -199,6 +199,7 @@ pub fn reload_sums(plan: &StreamPlan) -> Result<Option<Vec<[f64; 3]>>> {
     }
     let m = fenestra_formats::matrix::Matrix::read(name)
         .with_context(|| format!("cannot reload the sums in '{name}'"))?;
+    fenestra_cli::warn_all(m.notes.clone());
     let want = plan.items.len() * 3;
     if m.ncomp != 3 || m.data.len() != want {
         bail!(

@@ -25,6 +25,9 @@ pub struct Matrix {
     pub header: Header,
     /// Storage format of the input.
     pub format: DataFormat,
+    /// Warnings noticed while reading it (for the caller to report; the library prints
+    /// nothing): data beyond the header's rows, values that are not finite numbers.
+    pub notes: Vec<String>,
 }
 
 impl Matrix {
@@ -37,6 +40,7 @@ impl Matrix {
             data: vec![0.0; nrows * ncols * ncomp],
             header: Header::new(),
             format: DataFormat::Ascii,
+            notes: Vec::new(),
         }
     }
 
@@ -60,8 +64,9 @@ impl Matrix {
             data.extend_from_slice(&row);
             nrows += 1;
         }
+        let mut notes = r.take_notes();
         if r.has_trailing_data() {
-            fenestra_io::warn(format!(
+            notes.push(format!(
                 "{}: data beyond the {} rows of the header ignored",
                 r.name(),
                 nrows
@@ -74,6 +79,7 @@ impl Matrix {
             data,
             header: info.retained_header(),
             format: info.format,
+            notes,
         })
     }
 
@@ -116,6 +122,7 @@ impl Matrix {
             data,
             header: self.header.clone(),
             format: self.format,
+            notes: Vec::new(),
         }
     }
 }

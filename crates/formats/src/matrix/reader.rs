@@ -95,6 +95,8 @@ pub struct MatrixReader {
     tok: Vec<u8>,
     size_checked: bool,
     warned_nonfinite: bool,
+    /// Warnings noticed while reading, for the caller to report ([`Self::take_notes`]).
+    notes: Vec<String>,
 }
 
 impl MatrixReader {
@@ -218,6 +220,7 @@ impl MatrixReader {
             tok: Vec::new(),
             size_checked: false,
             warned_nonfinite: false,
+            notes: Vec::new(),
         })
     }
 
@@ -267,7 +270,7 @@ impl MatrixReader {
                     );
                 }
                 if (data as u128) > need {
-                    fenestra_io::warn(format!(
+                    self.notes.push(format!(
                         "{}: {} bytes of data beyond NROWS={} NCOLS={} NCOMP={} ignored",
                         self.name,
                         data as u128 - need,
@@ -279,6 +282,12 @@ impl MatrixReader {
             }
         }
         Ok(())
+    }
+
+    /// The warnings noticed so far (data beyond the header's rows, a value that is not a
+    /// finite number), taken out for the caller to report: the reader prints nothing.
+    pub fn take_notes(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.notes)
     }
 
     /// The input's name as given.
@@ -336,7 +345,7 @@ impl MatrixReader {
         if !self.warned_nonfinite && out.iter().any(|v| !v.is_finite()) {
             // carried through as Radiance does, but never silently
             self.warned_nonfinite = true;
-            fenestra_io::warn(format!(
+            self.notes.push(format!(
                 "{}: row {} holds a value that is not a finite number (nan or inf); results that use it will be too",
                 self.name, self.rows_read
             ));

@@ -23,6 +23,7 @@ fn mat(nrows: usize, ncols: usize, ncomp: usize, data: Vec<f64>) -> Matrix {
         data,
         header: Header::new(),
         format: DataFormat::Ascii,
+        notes: Vec::new(),
     }
 }
 
@@ -292,4 +293,21 @@ proptest! {
         bytes.truncate(keep);
         let _ = read_mem(bytes);
     }
+}
+
+#[test]
+fn reading_returns_its_warnings_instead_of_printing_them() {
+    let m =
+        read_mem(b"#?RADIANCE\nNROWS=2\nNCOLS=1\nNCOMP=1\nFORMAT=ascii\n\n1\nnan\n3\n".to_vec())
+            .unwrap();
+    assert_eq!(m.data.len(), 2);
+    assert_eq!(m.notes.len(), 2, "{:?}", m.notes);
+    assert!(m.notes[0].contains("row 2") && m.notes[0].contains("not a finite number"));
+    assert!(
+        m.notes[1].contains("data beyond the 2 rows"),
+        "{:?}",
+        m.notes
+    );
+    let clean = read_mem(b"#?RADIANCE\nNROWS=1\nNCOLS=1\nNCOMP=1\nFORMAT=ascii\n\n1\n".to_vec());
+    assert!(clean.unwrap().notes.is_empty());
 }

@@ -28,12 +28,18 @@ impl Tracer {
             }
             let mut pats = Vec::new();
             for k in scene.modifier_chain(m) {
-                pats.push(crate::pattern::compile(scene, k, &p.name, &opts.cal)?);
+                pats.push(crate::pattern::compile(
+                    scene,
+                    k,
+                    &p.name,
+                    &opts.cal,
+                    &opts.resolver,
+                )?);
             }
             if !pats.is_empty() {
                 patterns.insert(m, pats);
             }
-            let mat = compile(scene, m)?;
+            let mat = compile(scene, m, &opts.resolver)?;
             if let Material::Light {
                 kind: LightKind::Illum(Some(a)),
                 ..
@@ -41,7 +47,7 @@ impl Tracer {
             {
                 let a = *a;
                 mats.insert(m, mat);
-                let alt = compile(scene, a)?;
+                let alt = compile(scene, a, &opts.resolver)?;
                 mats.insert(a, alt);
                 return Ok(());
             }
