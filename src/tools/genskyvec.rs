@@ -1,6 +1,7 @@
 //! genskyvec: Reinhart sky vector of a gensky/gendaylit sky description.
 
 use anyhow::{anyhow, bail, Context, Result};
+use fenestra_scene::{Parser, Primitive};
 use fenestra_sky::cie::SkyBright;
 use fenestra_sky::daymtx::fmt_g;
 use fenestra_sky::patches::Reinhart;
@@ -8,85 +9,14 @@ use fenestra_sky::skyvec::{self, PerezLum, Row, SkyVecOptions, Sun};
 use std::io::{Read, Write};
 use std::process::ExitCode;
 
-/// One primitive of the description, words kept as written.
-struct Prim {
-    modifier: String,
-    ptype: String,
-    name: String,
-    sargs: Vec<String>,
-    rargs: Vec<String>,
-}
-
-/// Splits scene text into primitives (comments and `!command` lines skipped).
-fn primitives(text: &str) -> Result<Vec<Prim>> {
-    let mut words: Vec<(&str, usize)> = Vec::new();
-    for (ln, line) in text.lines().enumerate() {
-        let t = line.trim_start();
-        if t.starts_with('!') {
-            bail!(
-                "line {}: commands in sky descriptions are not supported by fenestra genskyvec",
-                ln + 1
-            );
-        }
-        for w in line.split_whitespace() {
-            if w.starts_with('#') {
-                break;
-            }
-            words.push((w, ln + 1));
-        }
-    }
-    let mut prims = Vec::new();
-    let mut i = 0;
-    let count = |i: usize, what: &str| -> Result<usize> {
-        let (w, ln) = words
-            .get(i)
-            .ok_or_else(|| anyhow!("unexpected end of sky description: expected {what}"))?;
-        w.parse::<usize>()
-            .map_err(|_| anyhow!("line {ln}: expected {what}, found '{w}'"))
-    };
-    while i < words.len() {
-        if i + 3 > words.len() {
-            bail!("line {}: incomplete primitive", words[i].1);
-        }
-        let (modifier, ptype, name) = (words[i].0, words[i + 1].0, words[i + 2].0);
-        i += 3;
-        let ns = count(i, "the number of string arguments")?;
-        let sargs = words
-            .get(i + 1..i + 1 + ns)
-            .ok_or_else(|| anyhow!("{name}: missing string arguments"))?
-            .iter()
-            .map(|w| w.0.to_string())
-            .collect();
-        i += 1 + ns;
-        let ni = count(i, "the number of integer arguments")?;
-        i += 1 + ni;
-        let nr = count(i, "the number of real arguments")?;
-        let rargs = words
-            .get(i + 1..i + 1 + nr)
-            .ok_or_else(|| anyhow!("{name}: missing real arguments"))?
-            .iter()
-            .map(|w| w.0.to_string())
-            .collect();
-        i += 1 + nr;
-        prims.push(Prim {
-            modifier: modifier.into(),
-            ptype: ptype.into(),
-            name: name.into(),
-            sargs,
-            rargs,
-        });
-    }
-    Ok(prims)
-}
-
 fn real(w: &str) -> Result<f64> {
     fenestra_cli::opts::parse_real(w).ok_or_else(|| anyhow!("'{w}' is not a number"))
 }
 
 /// The sky function of a description: gensky's and gendaylit's natively, any other
 /// brightfunc through the .cal engine.
-fn sky_function(p: &Prim) -> Result<Box<dyn Fn([f64; 3]) -> f64 + Sync>> {
-    let a: Vec<f64> = p.rargs.iter().map(|w| real(w)).collect::<Result<_>>()?;
+fn sky_function(p: &Primitive) -> Result<Box<dyn Fn([f64; 3]) -> f64 + Sync>> {
+    let a = p.rargs.clone();
     if p.ptype != "brightfunc" {
         bail!(
             "skyfunc is a '{}'; fenestra genskyvec evaluates brightfunc skies only",
@@ -194,36 +124,37 @@ Full documentation: fenestra doc genskyvec (docs/tools/genskyvec.md in the sourc
     std::io::stdin()
         .read_to_string(&mut text)
         .context("reading the sky description")?;
-    let prims = primitives(&text)?;
+    // the scene crate's parser, keeping the real arguments as written (the sun's
+    // radiance is printed back verbatim)
+    let mut parser = Parser::keeping_real_words();
+    parser.add_str(&text, "<stdin>")?;
+    let (scene, words) = parser.finish_with_words();
+    let prims = &scene.prims;
     let Some(skyfunc) = prims.iter().rev().find(|p| p.name == "skyfunc") else {
         bail!("Bad sky description!");
     };
     let f = sky_function(skyfunc)?;
     // the sun: a 'source' whose modifier is a 'light'
     let mut sun = None;
-    for p in &prims {
+    for p in prims {
         if p.ptype != "source" {
             continue;
         }
-        let Some(l) = prims
-            .iter()
-            .rev()
-            .find(|q| q.name == p.modifier && q.ptype == "light")
-        else {
+        let Some(m) = p.modifier.filter(|&m| prims[m].ptype == "light") else {
             continue;
         };
-        if l.rargs.len() < 3 || p.rargs.len() < 4 {
+        let (l, lw) = (&prims[m], &words[m]);
+        if l.rargs.len() < 3 || p.rargs.len() < 4 || lw.len() < 3 {
             bail!(
                 "sun '{}': light needs 3 and source 4 real arguments",
                 p.name
             );
         }
-        let w = [l.rargs[0].clone(), l.rargs[1].clone(), l.rargs[2].clone()];
         sun = Some(Sun {
-            radiance: [real(&w[0])?, real(&w[1])?, real(&w[2])?],
-            radiance_words: w,
-            dir: [real(&p.rargs[0])?, real(&p.rargs[1])?, real(&p.rargs[2])?],
-            diameter: real(&p.rargs[3])?,
+            radiance: [l.rargs[0], l.rargs[1], l.rargs[2]],
+            radiance_words: [lw[0].clone(), lw[1].clone(), lw[2].clone()],
+            dir: [p.rargs[0], p.rargs[1], p.rargs[2]],
+            diameter: p.rargs[3],
         });
     }
     let rows = skyvec::sky_vector(&opt, &*f, sun.as_ref());

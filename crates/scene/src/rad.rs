@@ -14,6 +14,9 @@ use crate::words::{parse_count, parse_real, Words};
 #[derive(Debug, Default)]
 pub struct Parser {
     scene: Scene,
+    /// With [`Parser::keeping_real_words`]: each primitive's real arguments as written
+    /// (empty for primitives that did not come from Radiance text).
+    real_words: Option<Vec<Vec<String>>>,
 }
 
 /// How deep `!command` output may itself run commands.
@@ -25,9 +28,34 @@ impl Parser {
         Parser::default()
     }
 
+    /// A parser that also keeps every primitive's real arguments as written (for tools that
+    /// print them back verbatim, as genskyvec prints the sun's radiance).
+    pub fn keeping_real_words() -> Self {
+        Parser {
+            real_words: Some(Vec::new()),
+            ..Parser::default()
+        }
+    }
+
     /// The scene read so far.
     pub fn finish(self) -> Scene {
         self.scene
+    }
+
+    /// The scene read so far and, per primitive, its real arguments as written (empty
+    /// lists unless the parser was made by [`Parser::keeping_real_words`]).
+    pub fn finish_with_words(self) -> (Scene, Vec<Vec<String>>) {
+        let n = self.scene.prims.len();
+        let mut words = self.real_words.unwrap_or_default();
+        words.resize(n, Vec::new());
+        (self.scene, words)
+    }
+
+    fn pad_words(&mut self) {
+        let n = self.scene.prims.len();
+        if let Some(w) = self.real_words.as_mut() {
+            w.resize(n, Vec::new());
+        }
     }
 
     /// The scene read so far, by reference.
@@ -85,6 +113,7 @@ impl Parser {
             p.modifier = p.modifier.map(|m| m + off);
             self.scene.prims.push(p);
         }
+        self.pad_words();
         Ok(())
     }
 
@@ -94,6 +123,7 @@ impl Parser {
             p.modifier = self.resolve_modifier(&p.modifier_name, &p.loc, &p.ptype, &p.name)?;
             self.scene.prims.push(p);
         }
+        self.pad_words();
         Ok(())
     }
 
@@ -185,6 +215,7 @@ impl Parser {
         }
         let nr = count(w, "real")?;
         let mut rargs = Vec::with_capacity(nr.min(64));
+        let mut rwords = Vec::new();
         for k in 0..nr {
             let s = word(w, &format!("real argument {} of {nr} of {what}", k + 1))?;
             let v = parse_real(&s).ok_or_else(|| {
@@ -194,6 +225,9 @@ impl Parser {
                 )
             })?;
             rargs.push(v);
+            if self.real_words.is_some() {
+                rwords.push(s);
+            }
         }
         crate::types::check(&ptype, ns, ni, nr).map_err(|e| anyhow!("{loc}: {what}: {e}"))?;
         let modifier = self.resolve_modifier(&modifier_name, loc, &ptype, &name)?;
@@ -207,6 +241,10 @@ impl Parser {
             rargs,
             loc: loc.clone(),
         });
+        if let Some(words) = self.real_words.as_mut() {
+            words.resize(self.scene.prims.len() - 1, Vec::new());
+            words.push(rwords);
+        }
         Ok(())
     }
 
@@ -331,6 +369,23 @@ fn quote(w: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn real_words_are_kept_as_written_when_asked() {
+        let text = "void light solar 0 0 3 6.643e+06 6.643E6 16\nsolar source sun 0 0 4 .5 -.5 .7 0.5\nvoid alias copy solar\n";
+        let mut p = Parser::keeping_real_words();
+        p.add_str(text, "t").unwrap();
+        let (scene, words) = p.finish_with_words();
+        assert_eq!(words.len(), scene.prims.len());
+        assert_eq!(words[0], ["6.643e+06", "6.643E6", "16"]);
+        assert_eq!(scene.prims[0].rargs, [6.643e6, 6.643e6, 16.0]);
+        assert_eq!(words[1], [".5", "-.5", ".7", "0.5"]);
+        assert!(words[2].is_empty());
+        // a plain parser keeps none
+        let mut q = Parser::new();
+        q.add_str(text, "t").unwrap();
+        assert!(q.finish_with_words().1.iter().all(Vec::is_empty));
+    }
 
     const SCENE: &str = "# a comment\nvoid plastic red 0 0 5 .5 .1 .1 0 0\n\
 red polygon p1 0 0 12 0 0 0 1 0 0 1 1 0 0 1 0\n\
