@@ -1,5 +1,5 @@
-//! `--help` of the tools that parse their options by hand: one line per option (a
-//! newcomer's first look), each line starting with the option.
+//! `--help` of the tools: one line per option (a newcomer's first look), each line
+//! starting with the option.
 
 mod common;
 
@@ -18,7 +18,8 @@ fn help_lists_each_option_on_its_own_line() {
                 "+s | -s", "+i | -i", "-c", "-u", "-g rfl", "-t turb", "-a lat", "-o lon", "-m mer",
             ],
         ),
-        ("genskyvec", &["-m N", "-c r g b", "-d", "-5", "-h"]),
+        // from its option table (fenestra_cli::opts::Spec)
+        ("genskyvec", &["-m N", "-c X Y Z", "-d", "-5", "-h"]),
         (
             "gendaymtx",
             &[

@@ -1,6 +1,7 @@
 //! genskyvec: Reinhart sky vector of a gensky/gendaylit sky description.
 
 use anyhow::{anyhow, bail, Context, Result};
+use fenestra_cli::opts::{Item, Kind, Opt, Spec};
 use fenestra_scene::{Parser, Primitive};
 use fenestra_sky::cie::SkyBright;
 use fenestra_sky::daymtx::fmt_g;
@@ -8,10 +9,6 @@ use fenestra_sky::patches::Reinhart;
 use fenestra_sky::skyvec::{self, PerezLum, Row, SkyVecOptions, Sun};
 use std::io::{Read, Write};
 use std::process::ExitCode;
-
-fn real(w: &str) -> Result<f64> {
-    fenestra_cli::opts::parse_real(w).ok_or_else(|| anyhow!("'{w}' is not a number"))
-}
 
 /// The sky function of a description: gensky's and gendaylit's natively, any other
 /// brightfunc through the .cal engine.
@@ -73,52 +70,52 @@ fn sky_function(p: &Primitive) -> Result<Box<dyn Fn([f64; 3]) -> f64 + Sync>> {
     }
 }
 
+fn spec() -> Spec {
+    Spec::new(
+        "genskyvec",
+        "Reinhart sky vector (ground first) of a sky description (gensky, gendaylit) on standard input",
+    )
+    .usage("[-h][-m N][-c r g b][-d][-5] < sky.rad")
+    .opt(Opt::new(
+        "m",
+        Kind::Int,
+        "Reinhart subdivision: 146, 578, 2306 rows for 1, 2, 4 (default 4: match D's -m/MF!)",
+    ))
+    .opt(Opt::new(
+        "c",
+        Kind::Vec3,
+        "sky colour r g b (default 0.960 1.004 1.118)",
+    ))
+    .opt(Opt::new("d", Kind::Flag, "sun only (sky patches zero)"))
+    .opt(Opt::new(
+        "5",
+        Kind::Flag,
+        "five-phase: the sun into its single nearest patch",
+    ))
+    .opt(Opt::new("h", Kind::Flag, "no header"))
+}
+
 /// Runs genskyvec.
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let mut opt = SkyVecOptions::default();
     let mut header = true;
-    let mut i = 1;
-    while i < args.len() {
-        match args[i].as_str() {
-            "-c" => {
-                for k in 0..3 {
-                    let w = args
-                        .get(i + 1 + k)
-                        .ok_or_else(|| anyhow!("-c needs r g b"))?;
-                    opt.color[k] = real(w)?;
+    for it in spec().parse(&args)? {
+        match it {
+            Item::Pos(w) => bail!("Unexpected command-line argument: {w}"),
+            Item::Opt(o) => match o.key {
+                "c" => opt.color = o.vec3(),
+                "m" => {
+                    opt.mf = usize::try_from(o.int())
+                        .ok()
+                        .filter(|&v| v >= 1)
+                        .ok_or_else(|| anyhow!("-m needs a positive integer, got {}", o.int()))?;
                 }
-                i += 3;
-            }
-            "-m" => {
-                let w = args
-                    .get(i + 1)
-                    .ok_or_else(|| anyhow!("-m needs a number"))?;
-                let mf = fenestra_cli::opts::parse_int(w)
-                    .filter(|&v| v >= 1)
-                    .ok_or_else(|| anyhow!("-m needs a positive integer, got '{w}'"))?;
-                opt.mf = mf as usize;
-                i += 1;
-            }
-            "-d" => opt.sky = false,
-            "-h" => header = false,
-            "-5" => opt.five_phase = true,
-            "--help" => {
-                println!(
-                    "Usage: genskyvec [-h][-m N][-c r g b][-d][-5] < sky.rad
-Reinhart sky vector (ground first) of a sky description (gensky, gendaylit) on standard input.
-Options:
-  -m N       Reinhart subdivision: 146, 578, 2306 rows for 1, 2, 4 (default 4: match D's -m/MF!)
-  -c r g b   sky colour (default 0.960 1.004 1.118)
-  -d         sun only (sky patches zero)
-  -5         five-phase: the sun into its single nearest patch
-  -h         no header
-Full documentation: fenestra doc genskyvec (docs/tools/genskyvec.md in the source)."
-                );
-                return Ok(ExitCode::SUCCESS);
-            }
-            w => bail!("Unexpected command-line argument: {w}"),
+                "d" => opt.sky = false,
+                "h" => header = false,
+                "5" => opt.five_phase = true,
+                _ => {}
+            },
         }
-        i += 1;
     }
     let mut text = String::new();
     std::io::stdin()

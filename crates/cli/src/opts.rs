@@ -282,10 +282,12 @@ impl Spec {
                 println!("{} (fenestra) {}", self.prog, env!("CARGO_PKG_VERSION"));
                 return Err(crate::Exit(0).into());
             }
+            // a negative number is a positional word unless it is a declared option
+            // (genskyvec's and gendaymtx's `-5`)
             let is_opt = !positional_only
                 && a.len() > 1
                 && (a.starts_with('-') || a.starts_with('+'))
-                && !looks_numeric(a);
+                && (!looks_numeric(a) || self.opts.iter().any(|o| o.name == &a[1..]));
             if !is_opt {
                 items.push(Item::Pos(a.clone()));
                 if !self.interleaved {
