@@ -12,6 +12,7 @@ pub mod resolution;
 pub mod rgbe;
 pub mod view;
 pub mod view_print;
+pub mod view_rays;
 
 pub use header::Header;
 pub use matrix::{DataFormat, Matrix, MatrixInfo, MatrixReader, MatrixWriter, WriteOptions};
