@@ -3,20 +3,17 @@
 // Per-channel colour arithmetic reads most clearly with explicit indices.
 #![allow(clippy::needless_range_loop)]
 
-use std::io::{BufRead, Read, Write};
+use std::io::Write;
 use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 use fenestra_cli::opts::{Item, Kind, Opt, Spec};
-use fenestra_formats::picture::{
-    capdate_lines, read_header_lines, read_pixels, read_resolution, PictureInfo,
-};
-use fenestra_formats::rgbe;
-use fenestra_formats::view::View;
+use fenestra_formats::picture::{capdate_lines, PictureInfo};
 
-#[path = "pcomb_expr.rs"]
-mod expr;
-use expr::{ExprInput, Exprs, Source};
+use fenestra_records::pcomb::combine::{write_pixels, Output};
+use fenestra_records::pcomb::expr::{ExprInput, Exprs};
+use fenestra_records::pcomb::input::{read_input, Input};
+use fenestra_trace::options::CalSource as Source;
 use std::sync::Arc;
 
 fn spec() -> Spec {
@@ -72,19 +69,6 @@ fn spec() -> Spec {
         Kind::Words(3),
         "scale the next input's r g b by these factors",
     ))
-}
-
-/// One input picture or matrix, in its stored scanline order.
-struct Input {
-    name: String,
-    lines: Vec<String>,
-    width: usize,
-    height: usize,
-    pixels: Vec<[f32; 3]>,
-    view: Option<View>,
-    original: bool,
-    exposure: f64,
-    aspect: f64,
 }
 
 /// Runs pcomb.
@@ -233,7 +217,14 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let mut exprs = if sources.is_empty() {
         None
     } else {
-        let mut e = Exprs::new(&sources, data.clone(), xres, yres)?;
+        let load = |p: &mut fenestra_calc::Program| -> Result<()> {
+            let resolver = fenestra_cli::raypath::Resolver::from_env();
+            for s in &sources {
+                s.load(p, &resolver)?;
+            }
+            Ok(())
+        };
+        let mut e = Exprs::new(&load, data.clone(), xres, yres)?;
         // Undefined names surface on the first evaluation: try one pixel before any
         // output is written, so an error leaves no partial picture.
         e.pixel(0, 0, [0.0; 3])?;
@@ -242,51 +233,12 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::with_capacity(1 << 16, stdout.lock());
     out.write_all(&head)?;
-    let mut row = vec![[0f32; 3]; xres];
-    let mut scan = vec![[0u8; 4]; xres];
-    let mut fbuf = Vec::with_capacity(xres * 12);
-    for yo in 0..yres {
-        // Output row yo from the top; y counts up from the bottom as in Radiance.
-        let y = yres - 1 - yo;
-        let yin = ((y as f64 + 0.5) * ymax as f64 / yres as f64) as usize;
-        let rin = ymax.saturating_sub(1).saturating_sub(yin);
-        for (x, px) in row.iter_mut().enumerate() {
-            let xin = ((x as f64 + 0.5) * xmax as f64 / xres as f64) as usize;
-            let mut sum = [0f64; 3];
-            for inp in data.iter() {
-                let p = inp.pixels[rin * inp.width + xin];
-                for k in 0..3 {
-                    sum[k] += p[k] as f64;
-                }
-            }
-            if let Some(e) = exprs.as_mut() {
-                sum = e
-                    .pixel(x, y, sum)
-                    .with_context(|| format!("pixel ({x}, {y})"))?;
-            }
-            for k in 0..3 {
-                px[k] = if !float_out && sum[k] < 0.0 {
-                    0.0
-                } else {
-                    sum[k] as f32
-                };
-            }
-        }
-        if float_out {
-            fbuf.clear();
-            for p in &row {
-                for v in p {
-                    fbuf.extend_from_slice(&v.to_ne_bytes());
-                }
-            }
-            out.write_all(&fbuf)?;
-        } else {
-            for (s, p) in scan.iter_mut().zip(&row) {
-                *s = rgbe::encode(*p);
-            }
-            fenestra_formats::picture_rle::write_scanline(&mut out, &scan)?;
-        }
-    }
+    let o = Output {
+        xres,
+        yres,
+        float_out,
+    };
+    write_pixels(&mut out, &data, exprs.as_mut(), (xmax, ymax), o)?;
     out.flush()?;
     Ok(ExitCode::SUCCESS)
 }
@@ -320,141 +272,4 @@ fn parse_res(w: &str, axis: &str, sources: &[Source], xmax: usize, ymax: usize) 
     } else {
         bail!("-{axis} {w}: the resolution evaluates to {v}")
     }
-}
-
-/// Reads a picture (any orientation; kept in stored scanline order, as Radiance's pcomb
-/// does) or a float/double RGB matrix.
-fn read_input(name: &str) -> Result<Input> {
-    let mut r = fenestra_cli::input::open(name)?;
-    let lines = read_header_lines(&mut r).with_context(|| format!("input '{name}'"))?;
-    let format = lines
-        .iter()
-        .find_map(|l| l.strip_prefix("FORMAT="))
-        .map(|f| f.trim().to_string());
-    let shown = if name == "-" {
-        "<stdin>"
-    } else if name.starts_with('!') {
-        "<Command>"
-    } else {
-        name
-    }
-    .to_string();
-    match format.as_deref() {
-        Some("float") | Some("double") => {
-            let (w, h, px) = read_matrix(&mut r, &lines, format.as_deref() == Some("double"))
-                .with_context(|| format!("input '{name}'"))?;
-            let info = PictureInfo::from_lines(
-                &lines
-                    .iter()
-                    .filter(|l| !l.starts_with("FORMAT="))
-                    .cloned()
-                    .collect::<Vec<_>>(),
-                "pcomb",
-            )
-            .with_context(|| format!("input '{name}'"))?;
-            Ok(Input {
-                name: shown,
-                lines,
-                width: w,
-                height: h,
-                pixels: px,
-                exposure: info.exposure,
-                aspect: info.pixaspect,
-                view: info.view,
-                original: false,
-            })
-        }
-        _ => {
-            let info = PictureInfo::from_lines(&lines, "pcomb")
-                .with_context(|| format!("input '{name}'"))?;
-            let res = read_resolution(&mut r).with_context(|| format!("input '{name}'"))?;
-            let pixels = read_pixels(&mut r, &res).with_context(|| format!("input '{name}'"))?;
-            let (exposure, aspect) = (info.exposure, info.pixaspect);
-            let mut view = info.view;
-            if let Some(v) = view.as_mut() {
-                if v.setup().is_err() {
-                    view = None;
-                }
-            }
-            Ok(Input {
-                name: shown,
-                lines,
-                width: res.scanlen(),
-                height: res.numscans(),
-                pixels,
-                view,
-                original: false,
-                exposure,
-                aspect,
-            })
-        }
-    }
-}
-
-fn read_matrix(
-    r: &mut impl BufRead,
-    lines: &[String],
-    double: bool,
-) -> Result<(usize, usize, Vec<[f32; 3]>)> {
-    let key = |k: &str| -> Option<i64> {
-        lines
-            .iter()
-            .find_map(|l| l.strip_prefix(k))
-            .and_then(|v| v.trim().parse().ok())
-    };
-    let (Some(rows), Some(cols)) = (key("NROWS="), key("NCOLS=")) else {
-        bail!("float matrix input needs NROWS and NCOLS in its header");
-    };
-    let ncomp = key("NCOMP=").unwrap_or(3);
-    if ncomp != 3 {
-        bail!("pcomb needs 3 components (RGB) per element, header says NCOMP={ncomp}");
-    }
-    if rows <= 0 || cols <= 0 {
-        bail!("bad matrix size NROWS={rows} NCOLS={cols}");
-    }
-    let big = lines
-        .iter()
-        .find_map(|l| l.strip_prefix("BigEndian="))
-        .map(|v| v.trim() == "1")
-        .unwrap_or(cfg!(target_endian = "big"));
-    let (rows, cols) = (rows as usize, cols as usize);
-    let size = if double { 8 } else { 4 };
-    let n = rows
-        .checked_mul(cols)
-        .and_then(|v| v.checked_mul(3 * size))
-        .context("matrix too large")?;
-    let mut data = Vec::new();
-    r.take(n as u64).read_to_end(&mut data)?;
-    if data.len() != n {
-        bail!(
-            "truncated matrix data: {} of {n} bytes for {rows} x {cols} RGB",
-            data.len()
-        );
-    }
-    let px = data
-        .chunks_exact(3 * size)
-        .map(|c| {
-            let mut p = [0f32; 3];
-            for k in 0..3 {
-                let b = &c[k * size..(k + 1) * size];
-                p[k] = if double {
-                    let a: [u8; 8] = b.try_into().unwrap_or([0; 8]);
-                    (if big {
-                        f64::from_be_bytes(a)
-                    } else {
-                        f64::from_le_bytes(a)
-                    }) as f32
-                } else {
-                    let a: [u8; 4] = b.try_into().unwrap_or([0; 4]);
-                    if big {
-                        f32::from_be_bytes(a)
-                    } else {
-                        f32::from_le_bytes(a)
-                    }
-                };
-            }
-            p
-        })
-        .collect();
-    Ok((cols, rows, px))
 }

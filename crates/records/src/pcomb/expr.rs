@@ -49,9 +49,6 @@ pub struct Exprs {
     lo: Option<VarId>,
 }
 
-/// A command-line source: `-e` text or `-f` file (the renderers' type, loaded the same way).
-pub use fenestra_trace::options::CalSource as Source;
-
 /// Radiance's luminance weights (`bright()`).
 const LUM: [f64; 3] = [0.265_074_126, 0.670_114_631, 0.064_811_243];
 
@@ -80,9 +77,10 @@ fn input_value(inputs: &[ExprInput], a: &[f64], chan: Option<usize>) -> f64 {
 }
 
 impl Exprs {
-    /// Compiles the sources for these inputs and output size.
+    /// Compiles the definitions `load` adds (the `-e`/`-f` sources, in order) for these
+    /// inputs and output size.
     pub fn new(
-        sources: &[Source],
+        load: &dyn Fn(&mut Program) -> Result<()>,
         inputs: Arc<Vec<ExprInput>>,
         xres: usize,
         yres: usize,
@@ -128,10 +126,7 @@ impl Exprs {
                 }),
             );
         }
-        let resolver = fenestra_cli::raypath::Resolver::from_env();
-        for s in sources {
-            s.load(&mut p, &resolver)?;
-        }
+        load(&mut p)?;
         let xy = p.bind_vars(&["x", "y"]);
         let exe = p.compile().map_err(|e| anyhow!("{e}"))?;
         let chans = [exe.var("ro"), exe.var("go"), exe.var("bo")];
