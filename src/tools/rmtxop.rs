@@ -6,8 +6,9 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 use fenestra_cli::opts::parse_real;
-use fenestra_dc::ops::{is_xml, multiply_chain, Mtx, Source, XmlPart};
+use fenestra_dc::ops::{is_xml, Mtx, Source, XmlPart};
 use fenestra_dc::ops_errors::Tracked;
+use fenestra_dc::rmtxop::{evaluate, load, load_from, load_tracked, propagate, Input, Op};
 use fenestra_formats::header::Header;
 use fenestra_formats::matrix::{AsciiLayout, DataFormat, MatrixWriter, WriteOptions};
 
@@ -37,27 +38,6 @@ Operators between matrices (evaluated left to right):
 Inputs: a file, '-' for the standard input, '!command' for a command's output, or a .xml BSDF.
 The result goes to the standard output with the inputs' headers and this command line.
 ";
-
-/// What joins a matrix to the result so far.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Op {
-    Product,
-    Sum,
-    ElemProduct,
-}
-
-/// One input with the options given before it.
-#[derive(Debug)]
-struct Input {
-    name: String,
-    op: Op,
-    transpose: bool,
-    scale: Option<Vec<f64>>,
-    cmat: Option<Vec<f64>>,
-    part: XmlPart,
-    /// `-R`: the file of its replicas.
-    replicas: Option<String>,
-}
 
 struct Parsed {
     verbose: bool,
@@ -244,36 +224,6 @@ fn stream(p: &Parsed, mut src: Source, args: &[String]) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Loads one input and applies its own options.
-fn load(inp: &Input, verbose: bool) -> Result<Mtx> {
-    if is_xml(&inp.name) {
-        return load_done(inp, Mtx::load(&inp.name, inp.part)?, verbose);
-    }
-    load_from(inp, Source::open(&inp.name)?, verbose)
-}
-
-/// Reads an opened input whole and applies its own options.
-fn load_from(inp: &Input, src: Source, verbose: bool) -> Result<Mtx> {
-    load_done(inp, Mtx::read_source(src)?, verbose)
-}
-
-fn load_done(inp: &Input, mut m: Mtx, verbose: bool) -> Result<Mtx> {
-    if verbose {
-        eprintln!(
-            "rmtxop: loaded {} ({}×{}, {} components)",
-            inp.name, m.nrows, m.ncols, m.ncomp
-        );
-    }
-    if inp.cmat.is_some() || inp.scale.is_some() {
-        m.transform(inp.cmat.as_deref(), inp.scale.as_deref())
-            .with_context(|| inp.name.clone())?;
-    }
-    if inp.transpose {
-        m.transpose();
-    }
-    Ok(m)
-}
-
 /// Runs rmtxop.
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let p = parse(&args)?;
@@ -284,7 +234,11 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         for inp in &p.inputs {
             tracked.push(load_tracked(inp, p.verbose)?);
         }
-        let m = evaluate(&p, tracked.iter().map(|t| t.value.clone()).collect())?;
+        let m = evaluate(
+            &p.inputs,
+            tracked.iter().map(|t| t.value.clone()).collect(),
+            p.verbose,
+        )?;
         write_errors(&p, e, tracked, &args)?;
         return write_result(&p, m, &args);
     }
@@ -305,107 +259,15 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     for inp in &p.inputs {
         mats.push(load(inp, p.verbose)?);
     }
-    let m = evaluate(&p, mats)?;
+    let m = evaluate(&p.inputs, mats, p.verbose)?;
     write_result(&p, m, &args)
 }
 
-/// The result of the loaded inputs `mats` (their own options applied): left to right, a
-/// run of products multiplied as one chain (cheapest pair first).
-fn evaluate(p: &Parsed, mats: Vec<Mtx>) -> Result<Mtx> {
-    let mut chain: Vec<(Mtx, String)> = Vec::new();
-    for (inp, m) in p.inputs.iter().zip(mats) {
-        if inp.op == Op::Product || chain.is_empty() {
-            chain.push((m, inp.name.clone()));
-            continue;
-        }
-        let mut acc = reduce_chain(std::mem::take(&mut chain), p.verbose)?;
-        match inp.op {
-            Op::Sum => acc
-                .add(&m)
-                .with_context(|| format!("{}: matrix sum failed", inp.name))?,
-            _ => acc
-                .elem_mul(&m)
-                .with_context(|| format!("{}: element-wise product failed", inp.name))?,
-        }
-        if p.verbose {
-            eprintln!("rmtxop: {:?} with {} done", inp.op, inp.name);
-        }
-        chain.push((acc, String::new()));
-    }
-    reduce_chain(chain, p.verbose)
-}
-
-/// One input with its replicas (`-R`) as a tracked matrix, its own options applied.
-fn load_tracked(inp: &Input, verbose: bool) -> Result<Tracked> {
-    let plain = Input {
-        name: inp.name.clone(),
-        op: inp.op,
-        transpose: false,
-        scale: None,
-        cmat: None,
-        part: inp.part,
-        replicas: None,
-    };
-    let value = load(&plain, verbose)?;
-    let mut t = match &inp.replicas {
-        None => Tracked::exact(value),
-        Some(name) => {
-            if is_xml(name) {
-                bail!("{name}: replicas are a matrix file (rtcontrib -E -Er K), not a BSDF");
-            }
-            let raw = fenestra_formats::matrix::Matrix::read(name)?;
-            fenestra_cli::warn_all(raw.notes.clone());
-            let k: usize = match raw.header.get("NREPLICAS").map(|v| v.trim().parse()) {
-                Some(Ok(k)) => k,
-                _ => bail!("{name}: no NREPLICAS= line: not a replica file of rtcontrib -Er"),
-            };
-            let reps = Mtx {
-                nrows: raw.nrows,
-                ncols: raw.ncols,
-                ncomp: raw.ncomp,
-                data: raw.data.iter().map(|&x| x as f32).collect(),
-                info: Vec::new(),
-                format: raw.format,
-            };
-            Tracked::with_replicas(value, &reps, k, name)?
-        }
-    };
-    if inp.cmat.is_some() || inp.scale.is_some() {
-        t.map(|m| m.transform(inp.cmat.as_deref(), inp.scale.as_deref()))
-            .with_context(|| inp.name.clone())?;
-    }
-    if inp.transpose {
-        t.map(|m| {
-            m.transpose();
-            Ok(())
-        })?;
-    }
-    Ok(t)
-}
-
-/// rmtxop's `-E`: the loaded inputs left to right (products too), each operation applied to
-/// the value and to every replica deviation; the result's standard errors written to `err`
-/// (the result itself is computed as without `-E`, so its bytes do not change).
+/// rmtxop's `-E`: the result's standard errors (carried from the inputs' replicas through
+/// every operation, [`propagate`]) written to `err` (the result itself is computed as
+/// without `-E`, so its bytes do not change).
 fn write_errors(p: &Parsed, err: &str, tracked: Vec<Tracked>, args: &[String]) -> Result<()> {
-    let mut acc: Option<Tracked> = None;
-    for (inp, t) in p.inputs.iter().zip(tracked) {
-        acc = Some(match acc {
-            None => t,
-            Some(a) => match inp.op {
-                Op::Product => a
-                    .multiply(&t)
-                    .with_context(|| format!("{}: matrix product failed", inp.name))?,
-                Op::Sum => a
-                    .sum(t)
-                    .with_context(|| format!("{}: matrix sum failed", inp.name))?,
-                Op::ElemProduct => a
-                    .elem_mul(&t)
-                    .with_context(|| format!("{}: element-wise product failed", inp.name))?,
-            },
-        });
-    }
-    let t = acc.context("no input matrix")?;
-    let se = t.standard_errors();
+    let se = propagate(&p.inputs, tracked)?;
     let mut opts = output_options(p, &se, args)?;
     if opts.format == DataFormat::Rgbe {
         opts.format = DataFormat::Ascii;
@@ -467,18 +329,4 @@ fn write_result(p: &Parsed, m: Mtx, args: &[String]) -> Result<ExitCode> {
     let mut out = w.finish()?;
     out.flush()?;
     Ok(ExitCode::SUCCESS)
-}
-
-/// Multiplies a chain of loaded matrices (a single matrix is returned as is).
-fn reduce_chain(chain: Vec<(Mtx, String)>, verbose: bool) -> Result<Mtx> {
-    let names: Vec<String> = chain.iter().map(|c| c.1.clone()).collect();
-    let mats: Vec<Mtx> = chain.into_iter().map(|c| c.0).collect();
-    if mats.len() > 1 {
-        if verbose {
-            eprintln!("rmtxop: multiplying {} matrices", mats.len());
-        }
-        let last = names.last().cloned().unwrap_or_default();
-        return multiply_chain(mats).with_context(|| format!("{last}: matrix product failed"));
-    }
-    mats.into_iter().next().context("no input matrix")
 }

@@ -4,5 +4,6 @@ pub mod errors;
 pub mod metrics;
 pub mod ops;
 pub mod ops_errors;
+pub mod rmtxop;
 pub mod steps;
 pub mod timestep;

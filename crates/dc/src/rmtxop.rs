@@ -1,0 +1,180 @@
+//! rmtxop's evaluation: its inputs with their own options (`-t -s -c -rf -rb -R`),
+//! loaded whole, combined left to right (a run of products multiplied as one chain,
+//! cheapest pair first), and the standard errors carried from replicas (`-E`).
+
+use anyhow::{bail, Context, Result};
+
+use crate::ops::{is_xml, multiply_chain, Mtx, Source, XmlPart};
+use crate::ops_errors::Tracked;
+
+/// What joins a matrix to the result so far.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Op {
+    /// `.`: matrix product (the default).
+    Product,
+    /// `+`: sum.
+    Sum,
+    /// `*`: element-wise product.
+    ElemProduct,
+}
+
+/// One input with the options given before it.
+#[derive(Debug)]
+pub struct Input {
+    /// File, `-`, `!command` or BSDF XML.
+    pub name: String,
+    /// What joins it to the result so far.
+    pub op: Op,
+    /// `-t`: transpose it.
+    pub transpose: bool,
+    /// `-s`: scale factors (one, or one per output component).
+    pub scale: Option<Vec<f64>>,
+    /// `-c`: component transform coefficients.
+    pub cmat: Option<Vec<f64>>,
+    /// `-rf`/`-rb`: which part of a BSDF XML.
+    pub part: XmlPart,
+    /// `-R`: the file of its replicas.
+    pub replicas: Option<String>,
+}
+
+/// Loads one input without its own options (`-t -s -c`).
+fn load_raw(inp: &Input, verbose: bool) -> Result<Mtx> {
+    let m = if is_xml(&inp.name) {
+        Mtx::load(&inp.name, inp.part)?
+    } else {
+        Mtx::read_source(Source::open(&inp.name)?)?
+    };
+    report(inp, &m, verbose);
+    Ok(m)
+}
+
+fn report(inp: &Input, m: &Mtx, verbose: bool) {
+    if verbose {
+        eprintln!(
+            "rmtxop: loaded {} ({}×{}, {} components)",
+            inp.name, m.nrows, m.ncols, m.ncomp
+        );
+    }
+}
+
+/// Applies an input's own options (`-s`/`-c`, then `-t`) to a matrix of it.
+fn apply_own(inp: &Input, m: &mut Mtx) -> Result<()> {
+    if inp.cmat.is_some() || inp.scale.is_some() {
+        m.transform(inp.cmat.as_deref(), inp.scale.as_deref())
+            .with_context(|| inp.name.clone())?;
+    }
+    if inp.transpose {
+        m.transpose();
+    }
+    Ok(())
+}
+
+/// Loads one input and applies its own options.
+pub fn load(inp: &Input, verbose: bool) -> Result<Mtx> {
+    let mut m = load_raw(inp, verbose)?;
+    apply_own(inp, &mut m)?;
+    Ok(m)
+}
+
+/// Reads an opened input whole and applies its own options.
+pub fn load_from(inp: &Input, src: Source, verbose: bool) -> Result<Mtx> {
+    let mut m = Mtx::read_source(src)?;
+    report(inp, &m, verbose);
+    apply_own(inp, &mut m)?;
+    Ok(m)
+}
+
+/// The result of the loaded inputs `mats` (their own options applied): left to right, a
+/// run of products multiplied as one chain (cheapest pair first).
+pub fn evaluate(inputs: &[Input], mats: Vec<Mtx>, verbose: bool) -> Result<Mtx> {
+    let mut chain: Vec<(Mtx, String)> = Vec::new();
+    for (inp, m) in inputs.iter().zip(mats) {
+        if inp.op == Op::Product || chain.is_empty() {
+            chain.push((m, inp.name.clone()));
+            continue;
+        }
+        let mut acc = reduce_chain(std::mem::take(&mut chain), verbose)?;
+        match inp.op {
+            Op::Sum => acc
+                .add(&m)
+                .with_context(|| format!("{}: matrix sum failed", inp.name))?,
+            _ => acc
+                .elem_mul(&m)
+                .with_context(|| format!("{}: element-wise product failed", inp.name))?,
+        }
+        if verbose {
+            eprintln!("rmtxop: {:?} with {} done", inp.op, inp.name);
+        }
+        chain.push((acc, String::new()));
+    }
+    reduce_chain(chain, verbose)
+}
+
+/// One input with its replicas (`-R`) as a tracked matrix, its own options applied to the
+/// value and to every replica deviation.
+pub fn load_tracked(inp: &Input, verbose: bool) -> Result<Tracked> {
+    let value = load_raw(inp, verbose)?;
+    let mut t = match &inp.replicas {
+        None => Tracked::exact(value),
+        Some(name) => {
+            if is_xml(name) {
+                bail!("{name}: replicas are a matrix file (rtcontrib -E -Er K), not a BSDF");
+            }
+            let raw = fenestra_formats::matrix::Matrix::read(name)?;
+            fenestra_cli::warn_all(raw.notes.clone());
+            let k: usize = match raw.header.get("NREPLICAS").map(|v| v.trim().parse()) {
+                Some(Ok(k)) => k,
+                _ => bail!("{name}: no NREPLICAS= line: not a replica file of rtcontrib -Er"),
+            };
+            let reps = Mtx {
+                nrows: raw.nrows,
+                ncols: raw.ncols,
+                ncomp: raw.ncomp,
+                data: raw.data.iter().map(|&x| x as f32).collect(),
+                info: Vec::new(),
+                format: raw.format,
+            };
+            Tracked::with_replicas(value, &reps, k, name)?
+        }
+    };
+    t.map(|m| apply_own(inp, m))?;
+    Ok(t)
+}
+
+/// The standard errors of the result: the tracked inputs combined left to right (products
+/// too), each operation applied to the value and to every replica deviation.
+pub fn propagate(inputs: &[Input], tracked: Vec<Tracked>) -> Result<Mtx> {
+    let mut acc: Option<Tracked> = None;
+    for (inp, t) in inputs.iter().zip(tracked) {
+        acc = Some(match acc {
+            None => t,
+            Some(a) => match inp.op {
+                Op::Product => a
+                    .multiply(&t)
+                    .with_context(|| format!("{}: matrix product failed", inp.name))?,
+                Op::Sum => a
+                    .sum(t)
+                    .with_context(|| format!("{}: matrix sum failed", inp.name))?,
+                Op::ElemProduct => a
+                    .elem_mul(&t)
+                    .with_context(|| format!("{}: element-wise product failed", inp.name))?,
+            },
+        });
+    }
+    let t = acc.context("no input matrix")?;
+    Ok(t.standard_errors())
+}
+
+/// Multiplies a chain of loaded matrices (a single matrix is returned as is).
+fn reduce_chain(chain: Vec<(Mtx, String)>, verbose: bool) -> Result<Mtx> {
+    let names: Vec<String> = chain.iter().map(|c| c.1.clone()).collect();
+    let mats: Vec<Mtx> = chain.into_iter().map(|c| c.0).collect();
+    if mats.len() > 1 {
+        if verbose {
+            eprintln!("rmtxop: multiplying {} matrices", mats.len());
+        }
+        let last = names.last().cloned().unwrap_or_default();
+        return multiply_chain(mats).with_context(|| format!("{last}: matrix product failed"));
+    }
+    mats.into_iter().next().context("no input matrix")
+}
