@@ -53,8 +53,7 @@ fn spec() -> Spec {
 
 /// A matrix as lux per sensor and hour: one component as is, three through [`LUX`].
 fn lux_rows(name: &str) -> Result<(usize, usize, Vec<f64>)> {
-    let m = Matrix::read(name)?;
-    fenestra_cli::warn_all(m.notes.clone());
+    let m = Matrix::read_reporting(name, fenestra_cli::warn_note)?;
     let w: &[f64] = match m.ncomp {
         1 => &[1.0],
         3 => &LUX,

@@ -158,7 +158,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         Some((td, _)) => td.cols,
         None if picture => 0, // learnt from the sky itself
         None => {
-            let r = MatrixReader::open(&vspec)?;
+            let r = MatrixReader::open(&vspec)?.report_to(fenestra_cli::warn_note);
             let n = r.info.ncols;
             v_reader = Some(r);
             n
@@ -212,8 +212,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
 
 /// A matrix file as a planar matrix.
 fn planar(name: &str) -> Result<fenestra_dc::timestep::Planar> {
-    let m = fenestra_formats::matrix::Matrix::read(name)?;
-    fenestra_cli::warn_all(m.notes.clone());
+    let m = fenestra_formats::matrix::Matrix::read_reporting(name, fenestra_cli::warn_note)?;
     fenestra_dc::timestep::Planar::from_interleaved(m.nrows, m.ncols, m.ncomp, &m.data)
         .map_err(|e| anyhow::anyhow!("{name}: {e:#}"))
 }
@@ -229,8 +228,7 @@ struct ErrorInputs<'a> {
 /// A matrix's errors from its standard-error file or its replica file.
 fn uncertainty(se: Option<&str>, rep: Option<&str>) -> Result<Uncertainty> {
     if let Some(name) = rep {
-        let m = fenestra_formats::matrix::Matrix::read(name)?;
-        fenestra_cli::warn_all(m.notes.clone());
+        let m = fenestra_formats::matrix::Matrix::read_reporting(name, fenestra_cli::warn_note)?;
         let k: usize = match m.header.get("NREPLICAS") {
             Some(v) => v.trim().parse().map_err(|_| {
                 anyhow::anyhow!("{name}: NREPLICAS={v} is not a number of replicas")

@@ -283,7 +283,7 @@ impl Spec {
                 return Err(crate::Exit(0).into());
             }
             // a negative number is a positional word unless it is a declared option
-            // (genskyvec's and gendaymtx's `-5`)
+            // (genskyvec's `-5`)
             let is_opt = !positional_only
                 && a.len() > 1
                 && (a.starts_with('-') || a.starts_with('+'))

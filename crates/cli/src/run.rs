@@ -2,7 +2,7 @@
 
 use std::process::ExitCode;
 
-pub use fenestra_io::diag::{prog, set_prog, set_warnings, warn, warn_all, warnings_on};
+pub use fenestra_io::diag::{prog, set_prog, set_warnings, warn, warn_note, warnings_on};
 
 /// A request to end the program quietly with the given status (e.g. after `--help`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -124,6 +124,7 @@ impl Source {
     }
 
     fn new(reader: MatrixReader, factors: Option<Vec<f32>>) -> Source {
+        let reader = reader.report_to(fenestra_cli::warn_note);
         let n = reader.info.row_len();
         Source {
             reader,
@@ -171,7 +172,6 @@ impl Source {
     /// Checks the end of the data after `nrows` rows: no rows at all, or data beyond
     /// what the header describes, are errors.
     pub fn finish(&mut self, nrows: usize) -> Result<()> {
-        fenestra_cli::warn_all(self.reader.take_notes());
         let info = &self.reader.info;
         let (ncols, ncomp, announced) = (info.ncols, info.ncomp, info.nrows);
         if announced.is_none() && nrows == 0 {

@@ -47,8 +47,7 @@ pub struct StepOptions {
 /// number of rows of T.
 pub fn load_td(tname: &str, dname: &str) -> Result<(Planar, usize)> {
     let t = load_t(tname)?;
-    let d = Matrix::read(dname)?;
-    fenestra_cli::warn_all(d.notes.clone());
+    let d = Matrix::read_reporting(dname, fenestra_cli::warn_note)?;
     if d.nrows != t.cols {
         bail!(
             "{dname} has {} rows, but T ({tname}) has {} columns: the daylight matrix must have one row per column of T",
@@ -77,8 +76,7 @@ pub fn load_t(name: &str) -> Result<Planar> {
         }
         return Ok(p);
     }
-    let m = Matrix::read(name)?;
-    fenestra_cli::warn_all(m.notes.clone());
+    let m = Matrix::read_reporting(name, fenestra_cli::warn_note)?;
     Planar::from_interleaved(m.nrows, m.ncols, m.ncomp, &m.data).with_context(|| name.to_string())
 }
 
@@ -99,9 +97,10 @@ pub fn read_sky(
             }
             let info = MatrixInfo::headerless(Some(rows), n, 3, fmt);
             MatrixReader::headerless(fenestra_cli::input::open(name)?, name, info)?
+                .report_to(fenestra_cli::warn_note)
         }
         None => {
-            let r = MatrixReader::open(name)?;
+            let r = MatrixReader::open(name)?.report_to(fenestra_cli::warn_note);
             if let Some(f) = o.in_fmt {
                 if f != r.info.format {
                     bail!(
@@ -167,7 +166,6 @@ pub fn read_sky(
             s
         }
     };
-    fenestra_cli::warn_all(r.take_notes());
     if o.nsteps.is_none() && r.has_trailing_data() {
         fenestra_cli::warn(format!("{shown}: data beyond the sky matrix ignored"));
     }
@@ -395,7 +393,6 @@ impl VRows {
                 all.extend_from_slice(&row);
                 n += 1;
             }
-            fenestra_cli::warn_all(reader.take_notes());
             reader.info.nrows = Some(n);
             held = Some((all, 0));
         }
@@ -421,7 +418,6 @@ impl VRows {
         while n < max && self.reader.read_row(&mut buf[n * len..(n + 1) * len])? {
             n += 1;
         }
-        fenestra_cli::warn_all(self.reader.take_notes());
         buf.truncate(n * len);
         Ok(n)
     }
@@ -438,7 +434,7 @@ pub fn matrix_form(
 ) -> Result<()> {
     let vr = match opened {
         Some(r) => r,
-        None => MatrixReader::open(vname)?,
+        None => MatrixReader::open(vname)?.report_to(fenestra_cli::warn_note),
     };
     let need = td.map(|m| m.rows).unwrap_or(sky.patches());
     if vr.info.ncols != need {

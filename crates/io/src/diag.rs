@@ -29,11 +29,10 @@ pub fn prog() -> &'static str {
     PROG.get().map(String::as_str).unwrap_or("fenestra")
 }
 
-/// Prints each of `notes` (warnings a library returned) as [`warn`] does.
-pub fn warn_all(notes: impl IntoIterator<Item = String>) {
-    for n in notes {
-        warn(n);
-    }
+/// [`warn`] for one owned message, usable as a `fn(String)` (a library's warning sink,
+/// e.g. `MatrixReader::report_to`).
+pub fn warn_note(msg: String) {
+    warn(msg);
 }
 
 /// Prints `prog: warning - msg` on stderr, as Radiance tools do.

@@ -12,4 +12,4 @@ pub mod numfmt;
 pub mod output;
 pub mod raypath;
 
-pub use diag::{prog, set_prog, set_warnings, warn, warn_all, warnings_on};
+pub use diag::{prog, set_prog, set_warnings, warn, warn_note, warnings_on};

@@ -298,6 +298,12 @@ impl Parser {
             loc: loc.clone(),
         };
         self.scene.prims.push(p);
+        if let Some(words) = self.real_words.as_mut() {
+            // an alias's arguments are its target's, words included
+            let w = words.get(t).cloned().unwrap_or_default();
+            words.resize(n, Vec::new());
+            words.push(w);
+        }
         Ok(())
     }
 }
@@ -380,7 +386,7 @@ mod tests {
         assert_eq!(words[0], ["6.643e+06", "6.643E6", "16"]);
         assert_eq!(scene.prims[0].rargs, [6.643e6, 6.643e6, 16.0]);
         assert_eq!(words[1], [".5", "-.5", ".7", "0.5"]);
-        assert!(words[2].is_empty());
+        assert_eq!(words[2], words[0]);
         // a plain parser keeps none
         let mut q = Parser::new();
         q.add_str(text, "t").unwrap();

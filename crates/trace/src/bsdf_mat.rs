@@ -154,29 +154,25 @@ impl LobeData<'_> {
     pub fn eval_sized(&self, v: DVec3, l: DVec3) -> (f64, f64) {
         match self {
             LobeData::Klems(c) => {
-                let size = c
-                    .view_patch_size(v)
-                    .zip(c.light_patch_size(l))
-                    .map_or(0.0, |(a, b)| a.min(b));
-                (c.eval(v, l), size)
+                let (f, size, _) = c.eval_full(v, l);
+                (f, size)
             }
             LobeData::Tree(t, lobe, front) => t.eval(*lobe, *front, v.to_array(), l.to_array()),
         }
     }
 
-    /// [`Self::eval_sized`] with the colour of [`Self::colour`] (a Klems cell looked up
-    /// once; a tree's colour only where the value is positive, grey elsewhere).
-    pub fn eval_full(&self, v: DVec3, l: DVec3) -> (f64, f64, DVec3) {
+    /// [`Self::eval_sized`] with the colour of [`Self::colour`] where it comes free: a Klems
+    /// cell is looked up once for all three; a tree's colour (`None`) costs a descent of
+    /// its own, for the caller to make only when it needs it.
+    pub fn eval_full(&self, v: DVec3, l: DVec3) -> (f64, f64, Option<DVec3>) {
         match self {
-            LobeData::Klems(c) => c.eval_full(v, l),
+            LobeData::Klems(c) => {
+                let (f, size, colour) = c.eval_full(v, l);
+                (f, size, Some(colour))
+            }
             LobeData::Tree(..) => {
                 let (f, size) = self.eval_sized(v, l);
-                let colour = if f > 0.0 {
-                    self.colour(v, l)
-                } else {
-                    DVec3::ONE
-                };
-                (f, size, colour)
+                (f, size, None)
             }
         }
     }

@@ -197,9 +197,8 @@ pub fn reload_sums(plan: &StreamPlan) -> Result<Option<Vec<[f64; 3]>>> {
     if name.starts_with('!') || !std::path::Path::new(name).exists() {
         return Ok(None);
     }
-    let m = fenestra_formats::matrix::Matrix::read(name)
+    let m = fenestra_formats::matrix::Matrix::read_reporting(name, fenestra_cli::warn_note)
         .with_context(|| format!("cannot reload the sums in '{name}'"))?;
-    fenestra_cli::warn_all(m.notes.clone());
     let want = plan.items.len() * 3;
     if m.ncomp != 3 || m.data.len() != want {
         bail!(

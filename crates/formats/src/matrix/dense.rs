@@ -44,9 +44,15 @@ impl Matrix {
         }
     }
 
-    /// Reads a whole matrix from `name` (`-`, `!command` or a file).
+    /// Reads a whole matrix from `name` (`-`, `!command` or a file); its warnings are kept
+    /// in [`Matrix::notes`].
     pub fn read(name: &str) -> Result<Matrix> {
         Self::read_from(MatrixReader::open(name)?)
+    }
+
+    /// Reads a whole matrix, handing its warnings to `sink` as they are noticed.
+    pub fn read_reporting(name: &str, sink: fn(String)) -> Result<Matrix> {
+        Self::read_from(MatrixReader::open(name)?.report_to(sink))
     }
 
     /// Reads every remaining row of `r`. Memory grows with the data actually read,
@@ -64,14 +70,15 @@ impl Matrix {
             data.extend_from_slice(&row);
             nrows += 1;
         }
-        let mut notes = r.take_notes();
         if r.has_trailing_data() {
-            notes.push(format!(
+            let msg = format!(
                 "{}: data beyond the {} rows of the header ignored",
                 r.name(),
                 nrows
-            ));
+            );
+            r.note(msg);
         }
+        let notes = r.take_notes();
         Ok(Matrix {
             nrows,
             ncols: info.ncols,

@@ -97,6 +97,8 @@ pub struct MatrixReader {
     warned_nonfinite: bool,
     /// Warnings noticed while reading, for the caller to report ([`Self::take_notes`]).
     notes: Vec<String>,
+    /// Where warnings go at once instead ([`Self::report_to`]).
+    sink: Option<fn(String)>,
 }
 
 impl MatrixReader {
@@ -221,6 +223,7 @@ impl MatrixReader {
             size_checked: false,
             warned_nonfinite: false,
             notes: Vec::new(),
+            sink: None,
         })
     }
 
@@ -270,7 +273,7 @@ impl MatrixReader {
                     );
                 }
                 if (data as u128) > need {
-                    self.notes.push(format!(
+                    self.note(format!(
                         "{}: {} bytes of data beyond NROWS={} NCOLS={} NCOMP={} ignored",
                         self.name,
                         data as u128 - need,
@@ -288,6 +291,24 @@ impl MatrixReader {
     /// finite number), taken out for the caller to report: the reader prints nothing.
     pub fn take_notes(&mut self) -> Vec<String> {
         std::mem::take(&mut self.notes)
+    }
+
+    /// Hands the warnings to `sink` as they are noticed (those noticed so far at once),
+    /// so a caller reports them when they happen, even if reading fails later.
+    pub fn report_to(mut self, sink: fn(String)) -> Self {
+        for n in self.notes.drain(..) {
+            sink(n);
+        }
+        self.sink = Some(sink);
+        self
+    }
+
+    /// A warning: to the sink, or kept for [`Self::take_notes`].
+    pub(crate) fn note(&mut self, msg: String) {
+        match self.sink {
+            Some(s) => s(msg),
+            None => self.notes.push(msg),
+        }
     }
 
     /// The input's name as given.
@@ -345,7 +366,7 @@ impl MatrixReader {
         if !self.warned_nonfinite && out.iter().any(|v| !v.is_finite()) {
             // carried through as Radiance does, but never silently
             self.warned_nonfinite = true;
-            self.notes.push(format!(
+            self.note(format!(
                 "{}: row {} holds a value that is not a finite number (nan or inf); results that use it will be too",
                 self.name, self.rows_read
             ));

@@ -311,3 +311,20 @@ fn reading_returns_its_warnings_instead_of_printing_them() {
     let clean = read_mem(b"#?RADIANCE\nNROWS=1\nNCOLS=1\nNCOMP=1\nFORMAT=ascii\n\n1\n".to_vec());
     assert!(clean.unwrap().notes.is_empty());
 }
+
+#[test]
+fn a_sink_hears_warnings_before_a_later_error() {
+    static HEARD: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+    fn sink(msg: String) {
+        HEARD.lock().unwrap().push(msg);
+    }
+    // row 2 is not a number, then the data stops a row short of NROWS
+    let text = b"#?RADIANCE\nNROWS=3\nNCOLS=1\nNCOMP=1\nFORMAT=ascii\n\n1\nnan\n".to_vec();
+    let r = MatrixReader::from_reader(Cursor::new(text), "mem")
+        .unwrap()
+        .report_to(sink);
+    assert!(Matrix::read_from(r).is_err());
+    let heard = HEARD.lock().unwrap();
+    assert_eq!(heard.len(), 1, "{heard:?}");
+    assert!(heard[0].contains("row 2") && heard[0].contains("not a finite number"));
+}

@@ -112,7 +112,11 @@ impl Tracer {
                     return;
                 };
                 let d = &self.distant[k];
-                let l = self.jitter_cone(dir, frame(dir), d.cos_half, cx);
+                let l = if self.opts.dj > 0.0 {
+                    self.jitter_cone(dir, frame(dir), d.cos_half, cx)
+                } else {
+                    dir
+                };
                 f(
                     cx,
                     SourceSample {
@@ -315,9 +319,11 @@ impl Tracer {
 /// The direction of a cap about unit `dir` (frame `a`, `b`) of solid angle 2π·`k` for the
 /// unit-square point (`u`, `v`), uniform by solid angle. The point (x, y) of the unit disk
 /// (concentric map) gives the angle from the axis, 1 − cos θ = w = k·r² (r² = x² + y² is
-/// uniform), and the azimuth; sin θ / r = √(k·(2 − w)), so neither a trigonometric call nor
-/// a division is needed, and the result is unit to within rounding.
+/// uniform), and the azimuth; sin θ / r = √(k·(2 − w)), so no trigonometric call is needed
+/// (the disk map's one division aside), and the result is unit to within rounding. `k` is
+/// held to 2 (the whole sphere), so a `-dj` above 1 cannot give a longer vector.
 pub(super) fn cone_direction(dir: DVec3, (a, b): (DVec3, DVec3), k: f64, u: f64, v: f64) -> DVec3 {
+    let k = k.min(2.0);
     let (x, y) = square_to_disk(u, v);
     let w = k * (x * x + y * y);
     let s = (k * (2.0 - w)).max(0.0).sqrt();

@@ -194,7 +194,7 @@ impl Tracer {
             let (f0, tomega, colour0) = c.eval_full(v, ll);
             let radius = tomega.max(0.0).sqrt() * shrink;
             if radius <= 0.0 {
-                return f0 * colour0;
+                return f0 * colour0.unwrap_or_else(|| c.colour(v, ll));
             }
             let mut g = jit.borrow_mut();
             let (mut sum, mut count) = (0.0, 0usize);
@@ -211,7 +211,7 @@ impl Tracer {
                     continue;
                 }
                 sum += f + diff_y;
-                sum_c += f * colour;
+                sum_c += f * colour.unwrap_or_else(|| c.colour(vj, ll));
                 sum_f += f;
                 count += 1;
             }
