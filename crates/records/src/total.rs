@@ -225,6 +225,24 @@ impl<W: Write> Printer<W> {
     }
 }
 
+/// Adds a record; with `-N`, prints the result when `N` records are pending.
+fn add_counted<W: Write>(
+    acc: &mut Acc,
+    row: &[f64],
+    pending: &mut usize,
+    o: &Settings,
+    p: &mut Printer<W>,
+) -> Result<()> {
+    acc.add(row);
+    *pending += 1;
+    if o.count > 0 && *pending == o.count {
+        p.print(acc, o.mean)?;
+        *pending = 0;
+        acc.next(o.running);
+    }
+    Ok(())
+}
+
 /// Totals one input.
 fn total_one<W: Write>(
     r: &mut dyn BufRead,
@@ -264,13 +282,7 @@ fn total_one<W: Write>(
                     });
                 }
                 rec += 1;
-                acc.add(&row);
-                pending += 1;
-                if o.count > 0 && pending == o.count {
-                    p.print(&acc, o.mean)?;
-                    pending = 0;
-                    acc.next(o.running);
-                }
+                add_counted(&mut acc, &row, &mut pending, o, p)?;
             }
             if pending > 0 {
                 p.print(&acc, o.mean)?;
@@ -303,13 +315,7 @@ fn total_one<W: Write>(
                         }
                         _ => row.extend(text.split_whitespace().map(atof)),
                     }
-                    acc.add(&row);
-                    pending += 1;
-                    if o.count > 0 && pending == o.count {
-                        p.print(&acc, o.mean)?;
-                        pending = 0;
-                        acc.next(o.running);
-                    }
+                    add_counted(&mut acc, &row, &mut pending, o, p)?;
                 }
                 if pending == 0 {
                     break 'sets;
