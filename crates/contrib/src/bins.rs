@@ -4,6 +4,8 @@
 
 use std::path::PathBuf;
 
+use fenestra_cli::raypath::Resolver;
+
 use anyhow::{anyhow, bail, Context, Result};
 use fenestra_calc::{Compiled, ExprId, Program, State, VarId};
 
@@ -28,6 +30,8 @@ enum Def {
 pub struct CalcDefs {
     rayinit: Option<PathBuf>,
     defs: Vec<Def>,
+    /// Where `rayinit.cal` and `-f` files are found.
+    resolver: Resolver,
 }
 
 /// Parses `-p` assignments (`a=1,b=2`; separators `,` `;` `:` or blanks).
@@ -57,11 +61,19 @@ pub fn parse_params(text: &str) -> Result<Vec<(String, f64)>> {
 }
 
 impl CalcDefs {
-    /// Starts with `rayinit.cal` preloaded when it is found on RAYPATH or in fenestra's lib.
+    /// Starts with `rayinit.cal` preloaded when it is found on RAYPATH or in fenestra's lib
+    /// (the environment's [`Resolver`]).
     pub fn new() -> Self {
+        Self::with_resolver(Resolver::from_env())
+    }
+
+    /// Starts with `rayinit.cal` preloaded when `resolver` finds it; `-f` files are found
+    /// through it too.
+    pub fn with_resolver(resolver: Resolver) -> Self {
         CalcDefs {
-            rayinit: fenestra_cli::raypath::find("rayinit.cal"),
+            rayinit: resolver.find("rayinit.cal"),
             defs: Vec::new(),
+            resolver,
         }
     }
 
@@ -73,9 +85,9 @@ impl CalcDefs {
         Ok(())
     }
 
-    /// Adds a `-f` file, found on RAYPATH (checked for syntax now).
+    /// Adds a `-f` file, found through the resolver (checked for syntax now).
     pub fn push_file(&mut self, name: &str) -> Result<()> {
-        let path = fenestra_cli::raypath::find_or_err(name)?;
+        let path = self.resolver.find_or_err(name)?;
         let mut p = Program::for_renderer();
         p.load_file(&path).map_err(|e| anyhow!("{e}"))?;
         self.defs.push(Def::File(path));
@@ -327,5 +339,31 @@ impl Bins {
     /// Whether modifier `m` has a non-constant bin expression.
     pub fn varies(&self, m: usize) -> bool {
         self.exprs[m].is_some()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn definitions_are_found_through_the_given_resolver() {
+        let dir = std::env::temp_dir().join(format!("fenestra-calcdefs-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("mine.cal"), "twice(x) = 2*x;\n").unwrap();
+        let mut defs = CalcDefs::with_resolver(Resolver::new(vec![dir.clone()]));
+        // no rayinit.cal in that folder: none preloaded
+        assert!(defs.rayinit.is_none());
+        defs.push_file("mine.cal").unwrap();
+        let e = defs.push_file("absent.cal").unwrap_err().to_string();
+        assert!(
+            e.contains("absent.cal") && e.contains(&dir.display().to_string()),
+            "{e}"
+        );
+        let mut p = defs.program().unwrap();
+        let id = p.add_expr("t", "twice(21)").unwrap();
+        let exe = p.compile().unwrap();
+        assert_eq!(exe.eval_expr(&mut exe.state(), id).unwrap(), 42.0);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

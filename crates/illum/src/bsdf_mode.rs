@@ -42,9 +42,10 @@ fn basis_of(n: usize) -> Option<&'static KlemsBasis> {
     .find(|b| b.len() == n)
 }
 
-/// Loads `name` (found through RAYPATH).
-pub fn load(name: &str) -> Result<Arc<BsdfData>> {
-    let path = fenestra_cli::raypath::find(name)
+/// Loads `name` (found through `resolver`: RAYPATH and fenestra's library by default).
+pub fn load(name: &str, resolver: &fenestra_cli::raypath::Resolver) -> Result<Arc<BsdfData>> {
+    let path = resolver
+        .find(name)
         .with_context(|| format!("cannot find BSDF file '{name}' (searched RAYPATH)"))?;
     let b = fenestra_bsdf::read_file(&path)
         .map_err(|e| anyhow::anyhow!("cannot load BSDF file '{}': {e}", path.display()))?;

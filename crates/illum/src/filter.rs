@@ -160,7 +160,7 @@ impl<'a> Filter<'a> {
         let mut fx = self.settings.apply(&line[10..]);
         if let Some(file) = fx.bsdf.take() {
             if !self.bsdfs.contains_key(&file) {
-                match crate::bsdf_mode::load(&file) {
+                match crate::bsdf_mode::load(&file, self.tracer.resolver()) {
                     Ok(d) => {
                         self.bsdfs.insert(file.clone(), d);
                     }

@@ -313,6 +313,11 @@ impl Tracer {
         &self.warnings
     }
 
+    /// Where the scene's auxiliary files were found (the options' resolver).
+    pub fn resolver(&self) -> &fenestra_io::raypath::Resolver {
+        &self.opts.resolver
+    }
+
     /// The effects switched on for this scene and options.
     pub fn effects(&self) -> &Effects {
         &self.effects
