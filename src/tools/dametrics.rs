@@ -221,9 +221,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     }
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     write_table(&mut out, &sensors, xy.as_deref(), &th)?;
-    let (sda, band) = metrics::spatial(&sensors, share);
-    let n = sensors.len().max(1) as f64;
-    let mean_da = sensors.iter().map(|s| s.da).sum::<f64>() / n;
+    let room = metrics::room(&sensors, share, sd.is_some());
+    let (sda, band, mean_da) = (room.sda, room.sda_band, room.mean_da);
     let occ = sensors.first().map_or(0, |s| s.hours);
     let pct = |x: f64| 100.0 * x;
     write!(
@@ -237,25 +236,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         write!(out, " (within ±{}σ: {:.1}–{:.1})", th.z, pct(lo), pct(hi))?;
     }
     write!(out, ", mean DA{} {:.1} %", th.da, pct(mean_da))?;
-    if sd.is_some() {
-        let lo = sensors
-            .iter()
-            .filter_map(|s| s.band)
-            .map(|b| b.da.0)
-            .sum::<f64>()
-            / n;
-        let hi = sensors
-            .iter()
-            .filter_map(|s| s.band)
-            .map(|b| b.da.1)
-            .sum::<f64>()
-            / n;
-        let flip = sensors
-            .iter()
-            .filter_map(|s| s.band)
-            .map(|b| b.da_flip)
-            .sum::<f64>()
-            / n;
+    if let Some((lo, hi, flip)) = room.da_band {
         write!(
             out,
             " ({:.1}–{:.1}; {:.1} % of hours could flip)",

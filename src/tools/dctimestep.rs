@@ -1,6 +1,7 @@
 //! dctimestep: daylight-coefficient time stepping, `V·T·D·s` or `DC·s`, with the
 //! sky given as a vector or a matrix of time steps (see docs/tools/dctimestep.md).
 
+use fenestra_cli::raypath::Resolver;
 use std::process::ExitCode;
 
 use anyhow::{bail, Result};
@@ -148,7 +149,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
 
     // T·D (None for the two-phase form, whose left matrix multiplies the sky directly).
     let td = match &td_specs {
-        Some((t, d)) => Some(load_td(t, d)?),
+        Some((t, d)) => Some(load_td(t, d, &Resolver::from_env())?),
         None => None,
     };
     // The two-phase form learns the sky's size from the left matrix: open it once here
@@ -262,7 +263,7 @@ fn write_errors(
     let uv = uncertainty(ins.ev, ins.rv)?;
     let e = match td {
         Some((tname, dname)) => {
-            let t = fenestra_dc::steps::load_t(tname)?;
+            let t = fenestra_dc::steps::load_t(tname, &Resolver::from_env())?;
             let d = planar(dname)?;
             let ud = uncertainty(ins.ed, ins.rd)?;
             fenestra_dc::errors::three_phase(&v, &uv, &t, &d, &ud, sky)?

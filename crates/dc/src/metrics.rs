@@ -125,9 +125,56 @@ pub fn spatial(sensors: &[SensorMetrics], share: f64) -> (f64, Option<(f64, f64)
     (sda, band)
 }
 
+/// A room's figures over its sensors.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Room {
+    /// Spatial daylight autonomy ([`spatial`]).
+    pub sda: f64,
+    /// Its band, when every sensor has one.
+    pub sda_band: Option<(f64, f64)>,
+    /// The sensors' mean daylight autonomy.
+    pub mean_da: f64,
+    /// With standard errors: the means of the sensors' DA band ends and of the share of
+    /// hours that could flip.
+    pub da_band: Option<(f64, f64, f64)>,
+}
+
+/// The room's figures: sDA for `share` with its band, the mean DA and, `with_errors`, the
+/// mean DA band and flip share (sensors without a band count as zero, over all sensors).
+pub fn room(sensors: &[SensorMetrics], share: f64, with_errors: bool) -> Room {
+    let (sda, sda_band) = spatial(sensors, share);
+    let n = sensors.len().max(1) as f64;
+    let mean = |f: &dyn Fn(&Band) -> f64| {
+        sensors
+            .iter()
+            .filter_map(|s| s.band)
+            .map(|b| f(&b))
+            .sum::<f64>()
+            / n
+    };
+    Room {
+        sda,
+        sda_band,
+        mean_da: sensors.iter().map(|s| s.da).sum::<f64>() / n,
+        da_band: with_errors.then(|| (mean(&|b| b.da.0), mean(&|b| b.da.1), mean(&|b| b.da_flip))),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn room_figures_average_over_all_sensors() {
+        let th = Thresholds::default();
+        let occ = [true; 4];
+        // DA 1.0 and 0.25 (300 lux threshold)
+        let a = sensor(&[400.0, 500.0, 600.0, 700.0], None, &occ, &th);
+        let b = sensor(&[100.0, 200.0, 250.0, 350.0], None, &occ, &th);
+        let r = room(&[a, b], 0.5, false);
+        assert_eq!((r.sda, r.mean_da), (0.5, 0.625));
+        assert!(r.sda_band.is_none() && r.da_band.is_none());
+    }
 
     #[test]
     fn hand_computed_sensor() {

@@ -3,6 +3,7 @@
 //! result rows written as they are done, and the picture form (one V picture per sky
 //! patch, weighted).
 
+use fenestra_cli::raypath::Resolver;
 use std::io::{BufWriter, Write};
 use std::path::Path;
 use std::process::ExitCode;
@@ -43,10 +44,10 @@ pub struct StepOptions {
     pub command: String,
 }
 
-/// Loads T (XML or matrix) and D, checks their sizes, and returns T·D with the
-/// number of rows of T.
-pub fn load_td(tname: &str, dname: &str) -> Result<(Planar, usize)> {
-    let t = load_t(tname)?;
+/// Loads T (XML found through `resolver`, or a matrix) and D, checks their sizes, and
+/// returns T·D with the number of rows of T.
+pub fn load_td(tname: &str, dname: &str, resolver: &Resolver) -> Result<(Planar, usize)> {
+    let t = load_t(tname, resolver)?;
     let d = Matrix::read_reporting(dname, fenestra_cli::warn_note)?;
     if d.nrows != t.cols {
         bail!(
@@ -61,10 +62,13 @@ pub fn load_td(tname: &str, dname: &str) -> Result<(Planar, usize)> {
     Ok((t.mul(&d)?, rows))
 }
 
-/// T from a BSDF XML file (as Radiance builds it) or a matrix file.
-pub fn load_t(name: &str) -> Result<Planar> {
+/// T from a BSDF XML file (found through `resolver`, as Radiance builds T from it) or a
+/// matrix file.
+pub fn load_t(name: &str, resolver: &Resolver) -> Result<Planar> {
     if !name.starts_with('!') && name.to_ascii_lowercase().ends_with(".xml") {
-        let path = fenestra_cli::raypath::find(name).unwrap_or_else(|| Path::new(name).into());
+        let path = resolver
+            .find(name)
+            .unwrap_or_else(|| Path::new(name).into());
         let b = fenestra_bsdf::read_file(&path).map_err(|e| anyhow!("{e}"))?;
         let m =
             fenestra_bsdf::radiance::transmission_matrix(&b).map_err(|e| anyhow!("{name}: {e}"))?;
