@@ -11,14 +11,7 @@ cd "$(dirname "$0")/.."
 runs=${1:-3}
 [ -f .oracle/env ] || scripts/oracle.sh > /dev/null
 set -a; . .oracle/env; set +a
-export FENESTRA_NO_PROGRESS=1
-bin=$(realpath "${CARGO_TARGET_DIR:-target}/testopt")
-lib=$(realpath lib)
-fix=$(realpath tests/fixtures)
-ref=${FENESTRA_SHARED:-$(cd .. && pwd)/shared}/reference/mkillum
-tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-cp "$ref"/{materials.rad,room.rad,exterior.rad,window_glass.rad,window_bsdf.rad,sky.rad,skyfunc_glow.rad,sensors.pts,window_illum_glass.rad,window_illum_bsdf.rad} "$tmp/"
-cp "$fix/threephase/blinds_kf.xml" "$tmp/"
+. benches/mkillum_room.sh
 O="$FENESTRA_ORACLE_BIN"
 
 timeit() { # label command...

@@ -9,14 +9,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seeds=${1:-6}
-export FENESTRA_NO_PROGRESS=1
-bin=$(realpath "${CARGO_TARGET_DIR:-target}/testopt")
-lib=$(realpath lib)
-fix=$(realpath tests/fixtures)
-ref=${FENESTRA_SHARED:-$(cd .. && pwd)/shared}/reference/mkillum
-tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-cp "$ref"/{materials.rad,room.rad,exterior.rad,window_glass.rad,window_bsdf.rad,sky.rad,skyfunc_glow.rad,sensors.pts,window_illum_glass.rad,window_illum_bsdf.rad} "$tmp/"
-cp "$fix/threephase/blinds_kf.xml" "$tmp/"
+. benches/mkillum_room.sh
 cd "$tmp"
 export RAYPATH=".:$lib"
 noise() { # label octree ad

@@ -106,12 +106,7 @@ fn genbsdf_and_mkillum_print_their_budget_with_v() {
     g.args(["-v", "-q", "-c", "4", "+mgf"])
         .arg(&mgf)
         .current_dir(&dir);
-    let out = g.output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = common::output_ok(&mut g);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         err.contains("genBSDF: effect: ambient") && err.contains("145 incident directions x "),

@@ -1086,12 +1086,7 @@ fn t4_7_runs_in_bounded_memory() {
         "black.rad",
     ])
     .current_dir(&dir);
-    let out = g.output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = common::output_ok(&mut g);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("reflection not averaged"), "{err}");
     // the memory line exists where the system reports it (Linux)

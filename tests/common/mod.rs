@@ -115,6 +115,21 @@ pub fn run_ok(cmd: &mut Command) -> Vec<u8> {
     out.stdout
 }
 
+/// Runs a command, asserting success, and returns its whole output (stdout, and stderr
+/// with its messages and `-v` lines).
+pub fn output_ok(cmd: &mut Command) -> std::process::Output {
+    let out = cmd
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run {cmd:?}: {e}"));
+    assert!(
+        out.status.success(),
+        "{cmd:?} failed ({}): {}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 /// Runs a command with `input` on its stdin and returns its whole output. A tool that
 /// exits before reading its input (e.g. after rejecting a scene) is not an error here:
 /// the broken pipe is ignored and the exit status tells the rest.

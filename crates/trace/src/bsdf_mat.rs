@@ -318,12 +318,6 @@ impl Component {
             .and_then(|i| self.m.incident.projected_solid_angle(i))
     }
 
-    /// Projected solid angle of the outgoing patch holding light direction `l`.
-    pub fn light_patch_size(&self, l: DVec3) -> Option<f64> {
-        self.out_index(l)
-            .and_then(|o| self.m.outgoing.projected_solid_angle(o))
-    }
-
     /// Incident index of a view vector `v` (local, pointing away from the surface).
     fn in_index(&self, v: DVec3) -> Option<usize> {
         // incident mappings: fi = (-x,-y,z), bi = (-x,-y,-z)

@@ -78,11 +78,13 @@ fn through(trans: Option<&LobeData>, v: DVec3, diff: f64) -> (f64, f64) {
     let Some(t) = trans else { return (0.0, 0.0) };
     let min = t.min_size();
     let rad = min.sqrt();
-    let mut samples: Vec<(f64, DVec3)> = OFFSETS
+    // (value, cell size) of each direction, from one evaluation
+    let mut samples: Vec<(f64, f64)> = OFFSETS
         .iter()
         .map(|&(dx, dy)| {
             let d = DVec3::new(-v.x + dx * rad, -v.y + dy * rad, -v.z).normalize();
-            (t.eval(v, d) + diff, d)
+            let (f, size) = t.eval_sized(v, d);
+            (f + diff, size)
         })
         .collect();
     samples.sort_by(|a, b| b.0.total_cmp(&a.0));
@@ -91,11 +93,10 @@ fn through(trans: Option<&LobeData>, v: DVec3, diff: f64) -> (f64, f64) {
     }
     let (mut peak, mut surr, mut ypeak, mut tsum, mut tsurr) = (0.0, 0.0, 0.0, 0.0, 0.0);
     let mut ns = 0.0;
-    for (i, &(y, d)) in samples.iter().enumerate() {
+    for (i, &(y, size)) in samples.iter().enumerate() {
         if i > 0 && y == samples[i - 1].0 {
             continue; // a duplicate cell
         }
-        let size = t.eval_sized(v, d).1;
         if size > 1.5 * min || ypeak > 8.0 * y * ns {
             if i == 0 {
                 return (0.0, 0.0);
