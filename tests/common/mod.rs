@@ -103,16 +103,7 @@ pub fn scratch(name: &str) -> PathBuf {
 
 /// Runs a command, asserting success, and returns its stdout.
 pub fn run_ok(cmd: &mut Command) -> Vec<u8> {
-    let out = cmd
-        .output()
-        .unwrap_or_else(|e| panic!("cannot run {cmd:?}: {e}"));
-    assert!(
-        out.status.success(),
-        "{cmd:?} failed ({}): {}",
-        out.status,
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out.stdout
+    output_ok(cmd).stdout
 }
 
 /// Runs a command, asserting success, and returns its whole output (stdout, and stderr
