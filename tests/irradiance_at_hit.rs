@@ -173,12 +173,14 @@ fn oracle_irradiance_at_hit_inside_antimatter_under_a_sky() {
     let exact = [floor, floor, std::f64::consts::FRAC_PI_2];
     // Tolerances for fenestra: 4 standard deviations of its values over 8 seeds (floor:
     // sd 0.0045 and 0.0076; the point in the sphere: 0.0013). The reference seeds its
-    // sampling from the clock: over 6 runs at different times it gave 1.3010 to 1.3254 on
-    // the floor (0.0245 below the exact value at worst; its mean about 1% low) and 1.5712
-    // to 1.5740 in the sphere, so it is held to 0.045 and 0.01. Before this was fixed,
-    // fenestra gave 0.0571 for the ray from inside and pi for the one from above.
+    // sampling from the clock (one seed per second): over 120 runs a second apart its
+    // values left the exact ones by −0.0085 ± 0.0067 and −0.0089 ± 0.0073 (mean ± sd) on
+    // the floor, +0.0015 ± 0.0032 in the sphere, so it is held to its mean offset plus 5
+    // sd: 0.045 and 0.018. (0.01 in the sphere, set from 6 runs, was 2.7 sd from the mean
+    // and failed once in CI at +0.0108.) Before this was fixed, fenestra gave 0.0571 for
+    // the ray from inside and pi for the one from above.
     let tol = [0.03, 0.03, 0.006];
-    let tol_oracle = [0.045, 0.045, 0.01];
+    let tol_oracle = [0.045, 0.045, 0.018];
     for k in 0..3 {
         let v = t[3 * k];
         assert!(
