@@ -9,10 +9,7 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use fenestra_cli::opts::{Item, Kind, Opt, Spec};
 use fenestra_dc::metrics::{self, SensorMetrics, Thresholds};
-use fenestra_formats::matrix::Matrix;
-
-/// Radiance's RGB → lux weights (179 lm/W × the luminance coefficients).
-const LUX: [f64; 3] = [47.435, 119.93, 11.635];
+use fenestra_dc::metrics_input;
 
 fn spec() -> Spec {
     Spec::new(
@@ -51,30 +48,6 @@ fn spec() -> Spec {
     ))
 }
 
-/// A matrix as lux per sensor and hour: one component as is, three through [`LUX`].
-fn lux_rows(name: &str) -> Result<(usize, usize, Vec<f64>)> {
-    let m = Matrix::read_reporting(name, fenestra_cli::warn_note)?;
-    let w: &[f64] = match m.ncomp {
-        1 => &[1.0],
-        3 => &LUX,
-        n => bail!("{name}: {n} components per value (1, lux, or 3, RGB, expected)"),
-    };
-    let v: Vec<f64> = m
-        .data
-        .chunks(m.ncomp)
-        .map(|c| c.iter().zip(w).map(|(x, k)| x * k).sum())
-        .collect();
-    // a metric over a value that is not a number would be one too: refused, with its place
-    if let Some(k) = v.iter().position(|x| !x.is_finite()) {
-        bail!(
-            "{name}: row {} (sensor), column {} (hour) is not a finite number; no metric can use it",
-            k / m.ncols.max(1) + 1,
-            k % m.ncols.max(1) + 1
-        );
-    }
-    Ok((m.nrows, m.ncols, v))
-}
-
 /// Occupied flags per column from a weather tape's records.
 fn occupancy(wea: &str, start: f64, end: f64, ncols: usize) -> Result<Vec<bool>> {
     let f =
@@ -95,27 +68,6 @@ fn occupancy(wea: &str, start: f64, end: f64, ncols: usize) -> Result<Vec<bool>>
             h >= start && h < end
         })
         .collect())
-}
-
-/// Sensor x y from a points file (as many as there are lines with numbers).
-fn sensor_xy(name: &str) -> Result<Vec<(f64, f64)>> {
-    let text = std::fs::read_to_string(name).with_context(|| format!("cannot read '{name}'"))?;
-    let mut out = Vec::new();
-    for (k, line) in text.lines().enumerate() {
-        let w: Vec<&str> = line.split_whitespace().collect();
-        if w.is_empty() {
-            continue;
-        }
-        let num = |i: usize| {
-            w.get(i)
-                .and_then(|s| fenestra_cli::opts::parse_real(s))
-                .with_context(|| {
-                    format!("{name}, line {}: a point 'x y z dx dy dz' expected", k + 1)
-                })
-        };
-        out.push((num(0)?, num(1)?));
-    }
-    Ok(out)
 }
 
 fn reals2(words: &[String], what: &str) -> Result<(f64, f64)> {
@@ -172,14 +124,14 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             pos.len()
         );
     };
-    let (rows, cols, lux) = lux_rows(name)?;
+    let (rows, cols, lux) = metrics_input::lux_rows(name)?;
     // standard errors of summed parts add in quadrature (independent runs)
     let sd = if errs.is_empty() {
         None
     } else {
         let mut var = vec![0.0; rows * cols];
         for e in &errs {
-            let (r, c, s) = lux_rows(e)?;
+            let (r, c, s) = metrics_input::lux_rows(e)?;
             if (r, c) != (rows, cols) {
                 bail!("{e}: {r}×{c} standard errors for a {rows}×{cols} matrix ({name})");
             }
@@ -197,7 +149,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         (None, Some(_)) => bail!("-o needs -w: the weather tape gives each column's hour"),
         (None, None) => vec![true; cols],
     };
-    let xy = pts.as_deref().map(sensor_xy).transpose()?;
+    let xy = pts.as_deref().map(metrics_input::sensor_xy).transpose()?;
     if let Some(xy) = &xy {
         if xy.len() != rows {
             bail!(

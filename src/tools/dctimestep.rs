@@ -229,15 +229,7 @@ struct ErrorInputs<'a> {
 /// A matrix's errors from its standard-error file or its replica file.
 fn uncertainty(se: Option<&str>, rep: Option<&str>) -> Result<Uncertainty> {
     if let Some(name) = rep {
-        let m = fenestra_formats::matrix::Matrix::read_reporting(name, fenestra_cli::warn_note)?;
-        let k: usize = match m.header.get("NREPLICAS") {
-            Some(v) => v.trim().parse().map_err(|_| {
-                anyhow::anyhow!("{name}: NREPLICAS={v} is not a number of replicas")
-            })?,
-            None => bail!(
-                "{name}: no NREPLICAS= line in the header: not a replica file of rtcontrib -Er"
-            ),
-        };
+        let (m, k) = fenestra_dc::replicas::read(name)?;
         let all =
             fenestra_dc::timestep::Planar::from_interleaved(m.nrows, m.ncols, m.ncomp, &m.data)
                 .map_err(|e| anyhow::anyhow!("{name}: {e:#}"))?;

@@ -31,11 +31,7 @@ enum SunOut {
 
 /// Runs gendaymtx.
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
-    if args.iter().skip(1).any(|a| a == "--help") {
-        println!(
-            "{} {USAGE}\nPerez all-weather sky matrix (rows = ground + Reinhart patches, columns = time steps).\nOptions:\n  -m N        Reinhart subdivision: 146, 578, 2306 rows for 1, 2, 4 (default 1)\n  -c r g b    sky colour (default 0.960 1.004 1.118)\n  -g r g b    ground reflectance (default 0.2 0.2 0.2)\n  -d | -s     sun only | sky only\n  -D file     write one sun per sunlit step ('-': to standard output, no matrix); -n: no matrix\n  -M file     list the sun modifiers (with -D)\n  -u          only steps with the sun up\n  -A          one column: the average over all steps\n  -r deg      rotate the sky counter-clockwise seen from above\n  -oa|-of|-od ascii | float | double output (default ascii)\n  -O0 | -O1   visible | solar radiance\n  -i min      data interval: steps near sunrise/sunset use their sunlit part\n  -5 deg      the sun into its nearest patch, solid angle from deg (five-phase)\n  -h          no header;  -v  progress and warnings\nFull documentation: fenestra doc gendaymtx (docs/tools/gendaymtx.md in the source).",
-            fenestra_cli::prog()
-        );
+    if fenestra_cli::help_asked(&args, USAGE, "Perez all-weather sky matrix (rows = ground + Reinhart patches, columns = time steps).\nOptions:\n  -m N        Reinhart subdivision: 146, 578, 2306 rows for 1, 2, 4 (default 1)\n  -c r g b    sky colour (default 0.960 1.004 1.118)\n  -g r g b    ground reflectance (default 0.2 0.2 0.2)\n  -d | -s     sun only | sky only\n  -D file     write one sun per sunlit step ('-': to standard output, no matrix); -n: no matrix\n  -M file     list the sun modifiers (with -D)\n  -u          only steps with the sun up\n  -A          one column: the average over all steps\n  -r deg      rotate the sky counter-clockwise seen from above\n  -oa|-of|-od ascii | float | double output (default ascii)\n  -O0 | -O1   visible | solar radiance\n  -i min      data interval: steps near sunrise/sunset use their sunlit part\n  -5 deg      the sun into its nearest patch, solid angle from deg (five-phase)\n  -h          no header;  -v  progress and warnings\nFull documentation: fenestra doc gendaymtx (docs/tools/gendaymtx.md in the source).") {
         return Ok(ExitCode::SUCCESS);
     }
     let mut o = DaymtxOptions::default();

@@ -3,7 +3,6 @@
 
 use anyhow::{bail, Result};
 use fenestra_sky::cie::{self, CieInputs, Given, SkyType};
-use fenestra_sky::daymtx::fmt_e;
 use fenestra_sky::solar::Site;
 use fenestra_sky::weather::atof;
 use std::f64::consts::PI;
@@ -279,42 +278,9 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         "# Ground ambient level: {:.1}\n",
         sky.ground_ambient
     ));
-    out.push_str(&description(&sky));
+    out.push_str(&sky.scene_text());
     std::io::stdout().lock().write_all(out.as_bytes())?;
     Ok(ExitCode::SUCCESS)
-}
-
-/// The scene text after the comment lines: optional sun, then `skyfunc`.
-pub fn description(sky: &cie::CieSky) -> String {
-    let mut out = String::new();
-    let d = sky.sun_dir;
-    if let Some(s) = sky.sun {
-        let e = fmt_e(s, 3);
-        out.push_str(&format!(
-            "\nvoid light solar\n0\n0\n3 {e} {e} {e}\n\nsolar source sun\n0\n0\n4 {:.6} {:.6} {:.6} 0.5\n",
-            d[0], d[1], d[2]
-        ));
-    }
-    out.push_str("\nvoid brightfunc skyfunc\n2 skybr skybright.cal\n0\n");
-    let t = sky.sky_type as i32;
-    if sky.sky_type.is_cloudy() {
-        out.push_str(&format!(
-            "3 {t} {} {}\n",
-            fmt_e(sky.zenith, 3),
-            fmt_e(sky.ground, 3)
-        ));
-    } else {
-        out.push_str(&format!(
-            "7 {t} {} {} {} {:.6} {:.6} {:.6}\n",
-            fmt_e(sky.zenith, 3),
-            fmt_e(sky.ground, 3),
-            fmt_e(sky.f2, 3),
-            d[0],
-            d[1],
-            d[2]
-        ));
-    }
-    out
 }
 
 fn defaults(inp: &CieInputs, site: &Site) -> String {

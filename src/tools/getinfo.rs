@@ -1,12 +1,12 @@
 //! getinfo: print the information header of Radiance files, strip it, add lines to it,
 //! or print a picture's (or matrix's) dimensions.
 
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{BufReader, Write};
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
+use fenestra_formats::dimensions::{is_picture, read_resolution};
 use fenestra_formats::header::Header;
-use fenestra_formats::resolution::Resolution;
 
 const HELP: &str = "getinfo: print or strip Radiance information headers
 
@@ -66,7 +66,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         }
         Some("-d") if rest.len() == 1 => {
             let mut r = stdin_reader();
-            let d = dimensions(&mut r, "<stdin>")?;
+            let d = fenestra_formats::dimensions::dimensions(&mut r, "<stdin>")?;
             writeln!(out, "{d}")?;
             true
         }
@@ -85,7 +85,9 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         Some("-d") => {
             let mut ok = true;
             for name in &rest[1..] {
-                match open(name).and_then(|mut r| dimensions(&mut r, name)) {
+                match open(name)
+                    .and_then(|mut r| fenestra_formats::dimensions::dimensions(&mut r, name))
+                {
                     Ok(d) => writeln!(out, "{name}: {d}")?,
                     Err(e) => {
                         out.flush()?;
@@ -132,68 +134,4 @@ fn stdin_reader() -> BufReader<std::io::StdinLock<'static>> {
 fn open(name: &str) -> Result<BufReader<std::fs::File>> {
     let f = std::fs::File::open(name).with_context(|| format!("cannot open '{name}'"))?;
     Ok(BufReader::with_capacity(1 << 16, f))
-}
-
-fn is_picture(h: &Header) -> bool {
-    h.format().is_none_or(|f| f.contains("_rle_"))
-        && h.ncols().ok().flatten().is_none()
-        && h.lines.first().is_some_and(|l| l.starts_with("#?"))
-}
-
-fn read_resolution(r: &mut impl BufRead, name: &str) -> Result<Resolution> {
-    let mut line = Vec::new();
-    r.take(128)
-        .read_until(b'\n', &mut line)
-        .with_context(|| format!("{name}: read error"))?;
-    let s = String::from_utf8_lossy(&line);
-    Resolution::parse(s.trim_end())
-        .with_context(|| format!("{name}: bad picture resolution string '{}'", s.trim_end()))
-}
-
-/// A picture's resolution string, or a matrix's shape from its header.
-fn dimensions(r: &mut impl BufRead, name: &str) -> Result<String> {
-    let h = Header::read(r, name)?;
-    if let (Ok(Some(nr)), Ok(Some(nc))) = (h.nrows(), h.ncols()) {
-        let ncomp = h.ncomp().ok().flatten().unwrap_or(3);
-        return Ok(format!("NROWS={nr} NCOLS={nc} NCOMP={ncomp}"));
-    }
-    if is_picture(&h) {
-        let res = read_resolution(r, name)?;
-        return Ok(res.to_string().trim_end().to_string());
-    }
-    // rcontrib/rtcontrib write NROWS only with -y: count the rows the data hold (fenestra)
-    if let Ok(Some(nc)) = h.ncols() {
-        let ncomp = h.ncomp().ok().flatten().unwrap_or(3);
-        let per_row = nc * ncomp;
-        let size = match h.format().map(str::trim) {
-            Some("float") => Some(4),
-            Some("double") => Some(8),
-            Some("ascii") | None => None,
-            Some(other) => anyhow::bail!("{name}: matrix format '{other}' without NROWS"),
-        };
-        let (values, rest) = match size {
-            Some(b) => {
-                let n = std::io::copy(r, &mut std::io::sink())
-                    .with_context(|| format!("{name}: read error"))?
-                    as usize;
-                (n / b, n % b)
-            }
-            None => {
-                let mut text = String::new();
-                r.read_to_string(&mut text)
-                    .with_context(|| format!("{name}: read error"))?;
-                (text.split_whitespace().count(), 0)
-            }
-        };
-        if per_row > 0 && rest == 0 && values % per_row == 0 {
-            return Ok(format!(
-                "NROWS={} NCOLS={nc} NCOMP={ncomp}",
-                values / per_row
-            ));
-        }
-        anyhow::bail!(
-            "{name}: {values} values are not whole rows of NCOLS={nc} x NCOMP={ncomp} (a truncated matrix?)"
-        );
-    }
-    anyhow::bail!("{name}: unknown file type (neither a picture nor a matrix with NCOLS)")
 }

@@ -20,11 +20,7 @@ fn num(args: &[String], i: usize) -> Result<f64> {
 
 /// Runs mkillum.
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
-    if args.iter().skip(1).any(|a| a == "--help") {
-        println!(
-            "{} {USAGE}\nReads scene text (from the files after '<', or standard input) and replaces the surfaces selected by #@mkillum directives with illum sources whose distribution is sampled through the scene.\nOptions:\n  -n N        threads\n  -w          no warnings\n  -v          effects, rays by kind, time, each surface's mean and standard errors\n  -E file     per surface: mean radiance and each direction's relative standard error\n  -ab -ad -as -lw -lr -dj -ds -dt -dc -st -ss -av -bv -seed ..  render options (defaults -ab 2 -dj .5 -dr 3 over rtrace's)\nDirectives (#@mkillum): o= m= f= a n i= e= b= c=d|a|n d= s= l+ l- u= !, and d=file.xml for BSDF data.\nFull documentation: fenestra doc mkillum (docs/tools/mkillum.md in the source).",
-            fenestra_cli::prog()
-        );
+    if fenestra_cli::help_asked(&args, USAGE, "Reads scene text (from the files after '<', or standard input) and replaces the surfaces selected by #@mkillum directives with illum sources whose distribution is sampled through the scene.\nOptions:\n  -n N        threads\n  -w          no warnings\n  -v          effects, rays by kind, time, each surface's mean and standard errors\n  -E file     per surface: mean radiance and each direction's relative standard error\n  -ab -ad -as -lw -lr -dj -ds -dt -dc -st -ss -av -bv -seed ..  render options (defaults -ab 2 -dj .5 -dr 3 over rtrace's)\nDirectives (#@mkillum): o= m= f= a n i= e= b= c=d|a|n d= s= l+ l- u= !, and d=file.xml for BSDF data.\nFull documentation: fenestra doc mkillum (docs/tools/mkillum.md in the source).") {
         return Ok(ExitCode::SUCCESS);
     }
     // mkillum's render defaults: rtrace's, with -dj .5 -dr 3 -ab 2

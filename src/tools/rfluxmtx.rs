@@ -241,11 +241,7 @@ fn load_scene(system: &[String], receivers: &str) -> Result<fenestra_scene::Scen
 
 /// Runs rfluxmtx.
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
-    if args.iter().skip(1).any(|a| a == "--help") {
-        println!(
-            "{} {USAGE}\nComputes the flux-transfer matrix from a sender (or rays on standard input with '-') to the receivers marked with #@rfluxmtx directives (h=u|kf|kh|kq|rN|scN|cie, u=, o=).\nOptions:\n  -v          the equivalent rcontrib command, sender directions, and at the end the run's budget\n  -bj frac    bin jitter: ,JTR=frac appended to every receiver's -p parameters\n  -i oct      the system scene as an octree\n  -c N        rays per sender bin (default 10000);  -n N  threads\n  -I / -i     rays on standard input are points and normals (with sender '-')\n  -f{{a,f,d}}{{a,f,d,c}}, -o spec, -x X -y Y, -E, -Er K, -ab -ad -lw .. as rcontrib's (docs/tools/rtcontrib.md)\nFull documentation: fenestra doc rfluxmtx (docs/tools/rfluxmtx.md in the source).",
-            fenestra_cli::prog()
-        );
+    if fenestra_cli::help_asked(&args, USAGE, "Computes the flux-transfer matrix from a sender (or rays on standard input with '-') to the receivers marked with #@rfluxmtx directives (h=u|kf|kh|kq|rN|scN|cie, u=, o=).\nOptions:\n  -v          the equivalent rcontrib command, sender directions, and at the end the run's budget\n  -bj frac    bin jitter: ,JTR=frac appended to every receiver's -p parameters\n  -i oct      the system scene as an octree\n  -c N        rays per sender bin (default 10000);  -n N  threads\n  -I / -i     rays on standard input are points and normals (with sender '-')\n  -f{a,f,d}{a,f,d,c}, -o spec, -x X -y Y, -E, -Er K, -ab -ad -lw .. as rcontrib's (docs/tools/rtcontrib.md)\nFull documentation: fenestra doc rfluxmtx (docs/tools/rfluxmtx.md in the source).") {
         return Ok(ExitCode::SUCCESS);
     }
     let (s, a) = screen(&args)?;

@@ -6,6 +6,7 @@ pub mod axis;
 pub mod plan;
 pub mod raster;
 pub mod svg;
+pub mod tone;
 
 /// One line of points.
 #[derive(Debug, Clone)]

@@ -108,6 +108,16 @@ fn quote_word(w: &str) -> String {
     }
 }
 
+/// When `--help` is among the arguments after the program name: prints
+/// `prog usage` and `text` on standard output and returns true (the tool then ends).
+pub fn help_asked(args: &[String], usage: &str, text: &str) -> bool {
+    if !args.iter().skip(1).any(|a| a == "--help") {
+        return false;
+    }
+    println!("{} {usage}\n{text}", prog());
+    true
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

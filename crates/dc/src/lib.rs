@@ -2,8 +2,10 @@
 
 pub mod errors;
 pub mod metrics;
+pub mod metrics_input;
 pub mod ops;
 pub mod ops_errors;
+pub mod replicas;
 pub mod rmtxop;
 pub mod steps;
 pub mod timestep;

@@ -120,12 +120,7 @@ pub fn load_tracked(inp: &Input, verbose: bool) -> Result<Tracked> {
             if is_xml(name) {
                 bail!("{name}: replicas are a matrix file (rtcontrib -E -Er K), not a BSDF");
             }
-            let raw =
-                fenestra_formats::matrix::Matrix::read_reporting(name, fenestra_cli::warn_note)?;
-            let k: usize = match raw.header.get("NREPLICAS").map(|v| v.trim().parse()) {
-                Some(Ok(k)) => k,
-                _ => bail!("{name}: no NREPLICAS= line: not a replica file of rtcontrib -Er"),
-            };
+            let (raw, k) = crate::replicas::read(name)?;
             let reps = Mtx {
                 nrows: raw.nrows,
                 ncols: raw.ncols,

@@ -2,6 +2,7 @@
 //! (ascii, float, double, RGBE) with streaming readers and Radiance-exact writers,
 //! pictures, resolution strings and views.
 
+pub mod dimensions;
 pub mod exr;
 pub mod header;
 pub mod matrix;

@@ -103,6 +103,41 @@ pub struct CieSky {
     pub sun: Option<f64>,
 }
 
+impl CieSky {
+    /// The scene text after the comment lines: optional sun, then `skyfunc`.
+    pub fn scene_text(&self) -> String {
+        let mut out = String::new();
+        let d = self.sun_dir;
+        if let Some(s) = self.sun {
+            let e = fenestra_cfmt::fmt_e(s, 3);
+            out.push_str(&format!(
+                "\nvoid light solar\n0\n0\n3 {e} {e} {e}\n\nsolar source sun\n0\n0\n4 {:.6} {:.6} {:.6} 0.5\n",
+                d[0], d[1], d[2]
+            ));
+        }
+        out.push_str("\nvoid brightfunc skyfunc\n2 skybr skybright.cal\n0\n");
+        let t = self.sky_type as i32;
+        if self.sky_type.is_cloudy() {
+            out.push_str(&format!(
+                "3 {t} {} {}\n",
+                fenestra_cfmt::fmt_e(self.zenith, 3),
+                fenestra_cfmt::fmt_e(self.ground, 3)
+            ));
+        } else {
+            out.push_str(&format!(
+                "7 {t} {} {} {} {:.6} {:.6} {:.6}\n",
+                fenestra_cfmt::fmt_e(self.zenith, 3),
+                fenestra_cfmt::fmt_e(self.ground, 3),
+                fenestra_cfmt::fmt_e(self.f2, 3),
+                d[0],
+                d[1],
+                d[2]
+            ));
+        }
+        out
+    }
+}
+
 fn norm_poly(sky: SkyType, altitude: f64) -> f64 {
     const CLEAR: [f64; 5] = [2.766521, 0.547665, -0.369832, 0.009237, 0.059229];
     const INTER: [f64; 5] = [3.5556, -2.7152, -1.3081, 1.0660, 0.60227];
