@@ -40,6 +40,9 @@ pub struct KlemsBasis {
     /// cos of each ring's upper polar bound (all rings but the last): the ring of a unit
     /// direction found from its z without an arc cosine.
     cos_hi: Vec<f64>,
+    /// Each ring's azimuthal patch boundaries as [`diamond`] angles, increasing, indexed from
+    /// the ring's first patch: a patch found from a direction without an arc tangent.
+    dbound: Vec<f64>,
 }
 
 /// Error building a basis from ring bounds.
@@ -108,11 +111,22 @@ impl KlemsBasis {
             .iter()
             .map(|r| r.theta_hi.to_radians().cos())
             .collect();
+        let dbound = out
+            .iter()
+            .flat_map(|r| {
+                let inc = 360.0 / r.nphi as f64;
+                (0..r.nphi).map(move |k| {
+                    let b = ((k as f64 + 0.5) * inc).to_radians();
+                    diamond(b.cos(), b.sin())
+                })
+            })
+            .collect();
         Ok(KlemsBasis {
             name: name.to_string(),
             rings: out,
             len: first,
             cos_hi,
+            dbound,
         })
     }
 
@@ -219,6 +233,9 @@ impl KlemsBasis {
                 .iter()
                 .position(|&c| u[2] >= c)
                 .unwrap_or(self.rings.len() - 1);
+            if let Some(p) = self.in_ring_fast(r, u[0], u[1]) {
+                return Some(p);
+            }
             let mut a = u[1].atan2(u[0]);
             if a < 0.0 {
                 a += 2.0 * PI;
@@ -230,6 +247,30 @@ impl KlemsBasis {
             return None;
         }
         self.patch_at(theta, phi)
+    }
+
+    /// The patch of ring `r` holding the azimuth of (`x`, `y`), found by comparing its
+    /// [`diamond`] angle with the ring's boundaries; `None` within 1e-9 of a boundary (about
+    /// 1e-9 radians, far above the rounding of either path), where [`Self::in_ring`] on the
+    /// arc tangent decides, so both paths give the same patch.
+    fn in_ring_fast(&self, r: usize, x: f64, y: f64) -> Option<usize> {
+        const MARGIN: f64 = 1e-9;
+        let ring = &self.rings[r];
+        if ring.nphi == 1 {
+            return Some(ring.first);
+        }
+        if x == 0.0 && y == 0.0 {
+            return None;
+        }
+        let b = &self.dbound[ring.first..ring.first + ring.nphi];
+        let d = diamond(x, y);
+        let k = b.partition_point(|&v| v <= d);
+        let near = |i: usize| b.get(i).is_some_and(|&v| (d - v).abs() <= MARGIN);
+        if near(k) || (k > 0 && near(k - 1)) {
+            return None;
+        }
+        // k boundaries at or below the azimuth: patch k, the last boundary wrapping to 0
+        Some(ring.first + if k == ring.nphi { 0 } else { k })
     }
 
     /// The patch of ring `r` at azimuth `phi_deg` (finite).
@@ -353,6 +394,22 @@ fn direction(cos_theta: f64, phi: f64) -> [f64; 3] {
     [s * phi.cos(), s * phi.sin(), cos_theta]
 }
 
+/// A monotonic stand-in for the azimuth of (`x`, `y`), not both zero: 0 at +x, 1 at +y, 2 at
+/// −x, 3 at −y, increasing counter-clockwise below 4 (one division, no arc tangent).
+pub fn diamond(x: f64, y: f64) -> f64 {
+    if y >= 0.0 {
+        if x >= 0.0 {
+            y / (x + y)
+        } else {
+            1.0 - x / (y - x)
+        }
+    } else if x < 0.0 {
+        2.0 - y / (-x - y)
+    } else {
+        3.0 + x / (x - y)
+    }
+}
+
 /// Polar angle (degrees, from +z, clamped to [0,180]) and azimuth (degrees in [0,360), from +x
 /// towards +y) of a unit local direction, computed as Radiance's `klems_full.cal` does.
 pub fn local_angles(v: [f64; 3]) -> (f64, f64) {
@@ -434,6 +491,60 @@ impl Frame {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The azimuth found through diamond angles equals the arc tangent's patch for every ring
+    /// of the three built-in bases: random directions, and directions at, just beside and
+    /// 1e-12 rad beside every patch boundary (where the fast path must defer).
+    #[test]
+    fn diamond_azimuth_matches_arc_tangent() {
+        let mut s = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rnd = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let exact = |b: &KlemsBasis, r: usize, x: f64, y: f64| {
+            let mut a = y.atan2(x);
+            if a < 0.0 {
+                a += 2.0 * PI;
+            }
+            b.in_ring(r, a / (PI / 180.0))
+        };
+        let (mut checked, mut deferred) = (0usize, 0usize);
+        for b in [
+            KlemsBasis::full(),
+            KlemsBasis::half(),
+            KlemsBasis::quarter(),
+        ] {
+            for r in 0..b.rings.len() {
+                let inc = 360.0 / b.rings[r].nphi as f64;
+                let mut angles: Vec<f64> = (0..20_000).map(|_| rnd() * 2.0 * PI).collect();
+                for k in 0..b.rings[r].nphi {
+                    let at = ((k as f64 + 0.5) * inc).to_radians();
+                    for e in [0.0, 1e-15, -1e-15, 1e-12, -1e-12, 1e-8, -1e-8, 1e-6, -1e-6] {
+                        angles.push(at + e);
+                    }
+                }
+                angles.extend([0.0, PI / 2.0, PI, 1.5 * PI, 2.0 * PI - 1e-15]);
+                for a in angles {
+                    let len = 0.3 + rnd();
+                    let (x, y) = (len * a.cos(), len * a.sin());
+                    match b.in_ring_fast(r, x, y) {
+                        Some(p) => {
+                            assert_eq!(p, exact(b, r, x, y), "ring {r} angle {a}");
+                            checked += 1;
+                        }
+                        None => deferred += 1,
+                    }
+                }
+            }
+        }
+        assert!(
+            deferred > 0 && checked > 100 * deferred,
+            "{checked} {deferred}"
+        );
+    }
 
     fn all() -> [&'static KlemsBasis; 3] {
         [
