@@ -267,8 +267,10 @@ impl<'a> Engine<'a> {
                 return;
             }
             let m = m as usize;
+            // Radiance 6 leaves out a contribution at most 1e-6 in every channel: the
+            // coefficient, or with -V the value (a sun on a dark surface keeps its value)
             let v = if self.opts.value { c.value } else { c.coef };
-            if self.opts.value && v.iter().all(|&x| x <= 1e-6) {
+            if v.iter().all(|&x| x <= 1e-6) {
                 return;
             }
             let b = if self.bins.varies(m) {

@@ -391,6 +391,9 @@ pub fn characterise_with(
                         };
                         let org = DVec3::new(px, py, z);
                         tracer.contributions(index, org, dir, &tracked, &mut |c| {
+                            if c.negligible_coef() {
+                                return;
+                            }
                             let dot = |w: [f64; 3]| -> f64 {
                                 c.coef.iter().zip(w).map(|(a, w)| a * w).sum()
                             };

@@ -210,6 +210,9 @@ pub fn characterise(
                 let dir = DVec3::new(dx, dy, if from_room { -dz } else { dz });
                 let org = DVec3::new(px, py, z);
                 tracer.contributions(index, org, dir, &tracked, &mut |c| {
+                    if c.negligible_coef() {
+                        return;
+                    }
                     let dot =
                         |w: [f64; 3]| -> f64 { c.coef.iter().zip(w).map(|(a, w)| a * w).sum() };
                     let d = c.dir;

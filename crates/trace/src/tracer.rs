@@ -87,6 +87,14 @@ pub struct Contribution {
     pub dist: f64,
 }
 
+impl Contribution {
+    /// Whether the coefficient is at most 1e-6 in every channel: what rcontrib without `-V`
+    /// leaves out (Radiance 6's cut-off; with `-V` the value is held to it instead).
+    pub fn negligible_coef(&self) -> bool {
+        self.coef.iter().all(|&x| x <= 1e-6)
+    }
+}
+
 #[derive(Debug, Clone)]
 struct Ray {
     org: DVec3,
@@ -387,7 +395,8 @@ impl Tracer {
             flags: r.flags | flag,
             weight: r.weight * maxc(rcoef),
             coef: r.coef * rcoef,
-            depth: r.depth + 1,
+            // Radiance's reflection level: every ray but a straight transmission adds one
+            depth: r.depth + i32::from(flag != TRANS),
             amb: r.amb,
             src: if flag == TRANS { r.src } else { None },
             skip,
@@ -413,9 +422,6 @@ impl Tracer {
             if self.sources[s].prim != prim {
                 return;
             }
-        }
-        if maxc(r.coef) <= 1e-6 {
-            return;
         }
         sink(Contribution {
             modifier: m,
@@ -452,7 +458,7 @@ impl Tracer {
         // record, a ray descending from an ambient sample, or a specular/transmitted one
         let kind = if r.flags & SHADOW != 0 {
             1
-        } else if r.depth == 0 {
+        } else if r.depth == 0 && r.flags == 0 {
             0
         } else if r.flags & AMBIENT != 0 {
             2
@@ -675,6 +681,27 @@ impl Tracer {
     fn spawn(&self, r: &Ray, s: &Surf, dir: DVec3, flag: u8, rcoef: DVec3, cx: &mut Ctx) -> DVec3 {
         let mut rc = rcoef;
         let mut c = self.child(r, self.origin(s), dir, flag, rc);
+        if !self.admit(&mut c, &mut rc, cx) {
+            return DVec3::ZERO;
+        }
+        rc * self.trace(&c, cx)
+    }
+
+    /// [`Self::spawn`] for one of several samples of a lobe: the child's weight is given
+    /// (the lobe's share, as Radiance's) beside the coefficient, which carries the sample's
+    /// own weighting.
+    fn spawn_weighted(
+        &self,
+        r: &Ray,
+        s: &Surf,
+        dir: DVec3,
+        flag: u8,
+        (rcoef, weight): (DVec3, f64),
+        cx: &mut Ctx,
+    ) -> DVec3 {
+        let mut rc = rcoef;
+        let mut c = self.child(r, self.origin(s), dir, flag, rc);
+        c.weight = weight;
         if !self.admit(&mut c, &mut rc, cx) {
             return DVec3::ZERO;
         }

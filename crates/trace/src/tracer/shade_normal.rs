@@ -3,6 +3,12 @@
 
 use super::*;
 
+/// Draws of a rough specular sample before it is given up (Radiance's MAXITER).
+const MAXITER: usize = 10;
+
+/// Radiance's FTINY: how far above (below) the surface a rough sample must leave.
+const FTINY_SPEC: f64 = 1e-6;
+
 /// The lobes of a plastic, metal or trans material (its colour comes patterned).
 #[derive(Debug, Clone, Copy)]
 pub(super) struct NormalLobes {
@@ -65,7 +71,9 @@ impl Tracer {
         let pdot = rod.abs().max(1e-3);
         let alpha2 = rough * rough;
         let pure = alpha2 <= FTINY;
-        let fres = |c: f64| (-5.85 * c).exp() - 0.00287989916;
+        // Radiance 6's estimate of the Fresnel factor (its normal.c: the constant was
+        // 0.00287989916, exp(−5.85), in Radiance 5)
+        let fres = |c: f64| (-5.85 * c).exp() - 0.00202943064;
         let mut rspec = spec;
         let use_fres = pure && spec >= 0.017999;
         if use_fres {
@@ -133,33 +141,12 @@ impl Tracer {
                 let dir = (d + nrm * (2.0 * pdot)).normalize();
                 val += self.spawn(r, s, dir, REFLECTED, scolor, cx);
             } else if rspec > FTINY && rspec > self.opts.st {
-                // one Ward-lobe sample (isotropic); below -ss 1 the variates are pulled
-                // toward the lobe's median, -ss 0 giving one fixed direction (Radiance's rule)
-                let (u, v) = self.spec_variates(cx);
-                let tan2 = -alpha2 * (1.0 - u).max(1e-300).ln();
-                let ct = 1.0 / (1.0 + tan2).sqrt();
-                let st = (1.0 - ct * ct).max(0.0).sqrt();
-                let (a, b) = frame(nrm);
-                let phi = 2.0 * PI * v;
-                let h = a * (st * phi.cos()) + b * (st * phi.sin()) + nrm * ct;
-                let dir = d - h * (2.0 * d.dot(h));
-                if dir.dot(nrm) > 0.0 {
-                    val += self.spawn(r, s, dir.normalize(), SPECULAR | REFLECTED, scolor, cx);
-                }
+                val += self.rough_reflection(r, s, nrm, alpha2, scolor, cx);
             }
             if tspec > FTINY && pure {
                 val += self.spawn(r, s, d, TRANS, color * tspec, cx);
             } else if tspec > FTINY && tspec > self.opts.st {
-                // the rough transmitted lobe: one Gaussian-spread sample about the ray's
-                // direction, kept when it still leaves through the far side
-                let (u, v) = self.spec_variates(cx);
-                let spread = (-alpha2 * (1.0 - u).max(1e-300).ln()).sqrt();
-                let (a, b) = frame(d);
-                let phi = 2.0 * PI * v;
-                let dir = (d + (a * phi.cos() + b * phi.sin()) * spread).normalize();
-                if dir.dot(nrm) < 0.0 {
-                    val += self.spawn(r, s, dir, SPECULAR | TRANS, color * tspec, cx);
-                }
+                val += self.rough_transmission(r, s, nrm, alpha2, color * tspec, cx);
             }
         }
         // A rough lobe too weak to sample (not above -st) joins the ambient coefficient of
@@ -184,16 +171,122 @@ impl Tracer {
         val
     }
 
-    /// Two variates for a specular lobe sample: uniform at `-ss` ≥ 1, pulled toward ½ by
-    /// the factor `-ss` below it (so `-ss 0` samples the lobe's median direction).
-    fn spec_variates(&self, cx: &mut Ctx) -> (f64, f64) {
-        let (u, v) = (cx.rng.next_f64(), cx.rng.next_f64());
-        let j = self.opts.ss;
-        if j >= 1.0 {
-            (u, v)
-        } else {
-            let j = j.max(0.0);
-            (0.5 + j * (u - 0.5), 0.5 + j * (v - 0.5))
+    /// How many samples a rough lobe of coefficient `coef` takes (Radiance's rule): one, or at
+    /// `-ss` above 1.5 that many times the ray's weight, rounded, while each keeps a weight
+    /// of at least `-lw`.
+    fn lobe_samples(&self, r: &Ray, coef: DVec3) -> usize {
+        let ss = self.opts.ss;
+        if ss <= 1.5 {
+            return 1;
         }
+        let mut n = (ss * r.weight + 0.5) as usize;
+        let w = r.weight * maxc(coef).min(1.0);
+        if w <= self.opts.lw * n as f64 {
+            n = (w / self.opts.lw) as usize;
+        }
+        n.max(1)
+    }
+
+    /// One draw of a Gaussian lobe's offset: its tangent (the angle's tangent from the
+    /// lobe's axis) and azimuth. Below `-ss` 1 the tangent's variate is pulled toward the
+    /// axis by that factor, `-ss 0` giving the axis itself (Radiance's rule).
+    fn lobe_offset(&self, alpha2: f64, cx: &mut Ctx) -> (f64, f64) {
+        let (u, v) = (cx.rng.next_f64(), cx.rng.next_f64());
+        let ss = self.opts.ss;
+        // 1 − u is in (0, 1], the variate whose logarithm gives the tangent
+        let q = if (0.0..1.0).contains(&ss) {
+            1.0 - ss * u
+        } else {
+            1.0 - u
+        };
+        let tan = if q <= FTINY_SPEC {
+            1.0
+        } else {
+            (-alpha2 * q.ln()).sqrt()
+        };
+        (tan, 2.0 * PI * v)
+    }
+
+    /// The rough (Ward) reflection of a plastic or metal: directions drawn about the
+    /// half-vector and drawn again, up to 10 times a sample, while they point below the
+    /// surface (so the lobe keeps its energy at grazing angles, as Radiance's). Several
+    /// samples (`-ss` > 1.5) are weighted as Radiance's W-G-M-D rule and by the number of
+    /// draws made; each traced ray carries its share in its coefficient.
+    fn rough_reflection(
+        &self,
+        r: &Ray,
+        s: &Surf,
+        nrm: DVec3,
+        alpha2: f64,
+        scolor: DVec3,
+        cx: &mut Ctx,
+    ) -> DVec3 {
+        let d = r.dir;
+        let (a, b) = frame(nrm);
+        let n = self.lobe_samples(r, scolor);
+        let rod = s.rod.abs();
+        let mut taken: Vec<(DVec3, f64)> = Vec::with_capacity(n);
+        let mut trials = 0usize;
+        while taken.len() < n && trials < MAXITER * n {
+            trials += 1;
+            let (tan, phi) = self.lobe_offset(alpha2, cx);
+            let h = nrm + (a * phi.cos() + b * phi.sin()) * tan;
+            let dir = d + h * (-2.0 * h.dot(d) / (1.0 + tan * tan));
+            let dot = dir.dot(nrm);
+            if dot <= FTINY_SPEC {
+                continue;
+            }
+            taken.push((dir.normalize(), 2.0 / (1.0 + rod / dot)));
+        }
+        if n == 1 {
+            return match taken.first() {
+                Some(&(dir, _)) => self.spawn(r, s, dir, SPECULAR | REFLECTED, scolor, cx),
+                None => DVec3::ZERO,
+            };
+        }
+        let weight = r.weight * maxc(scolor).min(1.0) / n as f64;
+        let mut val = DVec3::ZERO;
+        for (dir, w) in taken {
+            let coef = scolor * (w / trials as f64);
+            val += self.spawn_weighted(r, s, dir, SPECULAR | REFLECTED, (coef, weight), cx);
+        }
+        val
+    }
+
+    /// The rough transmission of a trans material: directions spread about the ray's own
+    /// across the surface's plane (Radiance's rule), drawn again up to 10 times a sample
+    /// while they do not leave through the far side; several samples (`-ss` > 1.5) share
+    /// the coefficient.
+    fn rough_transmission(
+        &self,
+        r: &Ray,
+        s: &Surf,
+        nrm: DVec3,
+        alpha2: f64,
+        coef: DVec3,
+        cx: &mut Ctx,
+    ) -> DVec3 {
+        let d = r.dir;
+        let (a, b) = frame(nrm);
+        let n = self.lobe_samples(r, coef);
+        let (mut taken, mut trials) = (0usize, 0usize);
+        let weight = r.weight * maxc(coef).min(1.0) / n as f64;
+        let share = coef / n as f64;
+        let mut val = DVec3::ZERO;
+        while taken < n && trials < MAXITER * n {
+            trials += 1;
+            let (tan, phi) = self.lobe_offset(alpha2, cx);
+            let dir = d + (a * phi.cos() + b * phi.sin()) * tan;
+            if dir.dot(nrm) >= -FTINY_SPEC {
+                continue;
+            }
+            taken += 1;
+            val += if n == 1 {
+                self.spawn(r, s, dir.normalize(), SPECULAR | TRANS, coef, cx)
+            } else {
+                self.spawn_weighted(r, s, dir.normalize(), SPECULAR | TRANS, (share, weight), cx)
+            };
+        }
+        val
     }
 }
