@@ -192,9 +192,12 @@ fn oracle_bsdf_jitter_statistics() {
             for v in 0..3 {
                 let (ta, ts) = common::mean_sem(&theirs[v * copies..(v + 1) * copies]);
                 let (oa, os) = common::mean_sem(&ours[v * copies..(v + 1) * copies]);
+                // 5 combined standard errors: over 14 checks 4 s.e. would fail about
+                // once in 600 runs (the oracle's clock-seeded means over 60 runs: z sd
+                // 0.87 to 1.14 of their s.e.), 5 about once in 30000
                 let se = (ts * ts + os * os).sqrt();
                 assert!(
-                    (ta - oa).abs() <= 4.0 * se + 1e-6 * ta.abs(),
+                    (ta - oa).abs() <= 5.0 * se + 1e-6 * ta.abs(),
                     "{name} -ss {ss} view {v}: oracle {ta} ± {ts}, ours {oa} ± {os}"
                 );
             }

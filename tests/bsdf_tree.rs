@@ -102,13 +102,20 @@ fn both(dir: &Path, scene: &[&str], opts: &[&str], orders: u64) -> (Vec<f64>, Ve
 /// Means of both tools within 4 combined standard errors of the mean (each tool's spread
 /// over its runs), and the gap printed.
 fn agree(what: &str, theirs: &[f64], ours: &[f64]) {
+    agree_within(what, theirs, ours, 0.0, 4.0);
+}
+
+/// As [`agree`], within `k` combined standard errors, the oracle's taken as at least
+/// `oracle_run_sd` (its single-run spread, measured over many of its runs) over √runs.
+fn agree_within(what: &str, theirs: &[f64], ours: &[f64], oracle_run_sd: f64, k: f64) {
     let (ta, ts) = common::mean_sem(theirs);
     let (oa, os) = common::mean_sem(ours);
+    let ts = ts.max(oracle_run_sd / (theirs.len() as f64).sqrt());
     let se = (ts * ts + os * os).sqrt();
     eprintln!("{what}: oracle {ta:.4} ± {ts:.4}, fenestra {oa:.4} ± {os:.4}");
     assert!(ta > 0.0 && oa > 0.0);
     assert!(
-        (ta - oa).abs() <= 4.0 * se,
+        (ta - oa).abs() <= k * se,
         "{what}: oracle {ta} ± {ts}, ours {oa} ± {os}"
     );
 }
@@ -265,7 +272,10 @@ fn oracle_coloured_tree_renders_in_colour() {
 /// its normal (an asymmetric device for this room), a low sun (Jun 21 18:45, altitude 7.7°)
 /// and a building opposite, `-ab 5`: the building hiding the sun (Radiance gave 0 at
 /// `-ab 1` where fenestra gave 9% before) and a low building letting it in. Means over 20
-/// sensors, the oracle's over 8 input orders, ours over 8 seeds, within 4 combined s.e.
+/// sensors, the oracle's over 8 input orders, ours over 8 seeds, within 4.5 combined s.e.,
+/// the oracle's from its single-run spread measured over 80 clock-seeded runs (0.0069 in
+/// the room, 0.52 with the low building; estimated from its 8 runs, it varied from 0.0014
+/// to 0.0035 and the 4 s.e. test failed about once in 80 runs, once in CI).
 #[test]
 fn oracle_west_room_low_sun_ab5() {
     if common::oracle().is_none() {
@@ -305,12 +315,12 @@ fn oracle_west_room_low_sun_ab5() {
     }
     std::fs::write(dir.join("sensors.pts"), pts).unwrap();
     let opts = ["-ab", "5", "-ad", "1024", "-lw", "1e-5"];
-    for room in ["room.rad", "low.rad"] {
+    for (room, oracle_run_sd) in [("room.rad", 0.0069), ("low.rad", 0.52)] {
         // 8 runs each: with 4, a CI run's oracle spread came out 3x smaller than another
         // run's (0.0011 vs 0.0037) and the 4 s.e. limit failed at 4.4 (the s.e. of 4 samples
         // is itself uncertain by ~40%)
         let (t, o) = both(&dir, &[room, "window.rad", "sky.rad"], &opts, 8);
-        agree(&format!("west {room} -ab 5"), &t, &o);
+        agree_within(&format!("west {room} -ab 5"), &t, &o, oracle_run_sd, 4.5);
     }
 }
 

@@ -165,12 +165,13 @@ fn oracle_jittered_tubes_agree_within_monte_carlo_error() {
                     .collect()
             };
             let ((mt, st), (mo, so)) = (common::mean_sem(&pick(&t)), common::mean_sem(&pick(&o)));
-            // 4 combined standard errors: a false failure about once in 16000 checks.
+            // 5 combined standard errors (4 would fail about once in 2500 runs over the
+            // 9 checks: the oracle's clock-seeded means vary by 0.84 to 1.06 s.e.).
             // Measured at the first floor point: spread per record 39% of the mean with
             // -ds 0, 5.6% with the default -ds .2, 0.5% with -ds .05; over the 9 checks
             // the two spreads agree within 0.95 to 1.13 and the means within 1.3
             // combined standard errors.
-            let tol = 4.0 * (st * st + so * so).sqrt();
+            let tol = 5.0 * (st * st + so * so).sqrt();
             assert!(
                 (mt - mo).abs() <= tol,
                 "{extra:?} point {}: oracle {mt} ± {st}, ours {mo} ± {so}",

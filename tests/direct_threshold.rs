@@ -290,10 +290,10 @@ fn oracle_thresholding_with_an_ambient_bounce() {
     // they gather and to the ray's weight (1/256 here), with statistics carried over the
     // run. Both tools are random here, so the comparison is on the total over the points
     // of -dt .03 over that of -dt 0 (one run each), on 120 points (the fixture's 30 shifted
-    // 4 times by 1.3 cm). Measured over 6 runs (at 679be5c): oracle 0.96702 (sd 0.00025 per
-    // run), fenestra 0.96649 (sd 0.00047, seeds 1 to 6); 0.004 is 6.4 standard deviations
-    // of the difference of two single runs above that mean difference, against an effect
-    // of 0.033. (Radiance's
+    // 4 times by 1.3 cm). Measured: oracle 0.96710 (sd 0.00041 per run over 60 clock-seeded
+    // runs; 6 runs had suggested 0.00025), fenestra 0.96649 (sd 0.00047, seeds 1 to 6, at
+    // 679be5c); 0.004 is 5.5 standard deviations of the difference of two single runs
+    // above that mean difference, against an effect of 0.033. (Radiance's
     // own -n 2 moves this ratio by 0.002 to 0.0075 on these scenes: each process keeps its
     // own statistics.)
     let Some(oracle) = common::oracle() else {

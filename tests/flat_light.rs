@@ -281,8 +281,11 @@ fn oracle_jittered_flat_sources_agree_within_monte_carlo_error() {
                 };
                 let ((mt, st), (mo, so)) =
                     (common::mean_sem(&pick(&t)), common::mean_sem(&pick(&o)));
-                // 4 combined standard errors: a false failure about once in 16000 checks
-                let tol = 4.0 * (st * st + so * so).sqrt();
+                // 5 combined standard errors. The oracle's 1000-record means vary between
+                // its clock-seeded runs by 1.02 to 1.20 of their standard errors (skewed
+                // values; 60 runs a second apart): at 4 s.e. the 24 checks would fail
+                // about once in 300 runs, at 5 about once in 20000.
+                let tol = 5.0 * (st * st + so * so).sqrt();
                 eprintln!(
                     "{name} {extra:?} point {}: oracle {mt:.6} ± {st:.2e}, ours {mo:.6} ± {so:.2e}, {:.2} s.e.",
                     p.trim(),
@@ -293,10 +296,13 @@ fn oracle_jittered_flat_sources_agree_within_monte_carlo_error() {
                     "{name} {extra:?} point {}: oracle {mt} ± {st}, ours {mo} ± {so}",
                     p.trim()
                 );
-                // spreads per record within a factor 1.5 (with 1000 records a standard
-                // deviation is known to about 2-3%, more for skewed values)
+                // spreads per record within a factor 2: with 1000 skewed records a
+                // spread is known less well than its normal-theory 2-3%; the oracle's own
+                // spread at the square's first point with -ds 0 -dj .9 varied by 9.7%
+                // (sd of its log over 360 runs), so two runs differ by a log-ratio of sd
+                // 0.137, and 1.5 (2.96 sd) failed 0.28% of oracle pairs; 2 is 5 sd.
                 assert!(
-                    u == "-u-" || (st == 0.0 && so == 0.0) || (so < 1.5 * st && st < 1.5 * so),
+                    u == "-u-" || (st == 0.0 && so == 0.0) || (so < 2.0 * st && st < 2.0 * so),
                     "{name} {extra:?} point {}: spreads {st} {so}",
                     p.trim()
                 );

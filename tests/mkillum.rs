@@ -88,12 +88,14 @@ fn oracle_directives_and_layout() {
     // alias and void surfaces, under a sky and a ground glow (-ab 0: each ray returns the
     // glow it meets). Output text must be identical with the numbers masked, the same data
     // files must be written, and the averages agree: exactly (1e-5) where every ray sees
-    // one glow (the up window, 2 2.5 3), within 1e-4 for the ring (both 2.3998..), and within 10% for the
-    // side window, half sky half ground: its ~6 bins straddling the horizon split their 4
-    // rays between sky and ground at random in Radiance (unseeded), so the sky fraction
-    // has an sd of about sqrt(6*4/4)/108 = 2.3%, 3.3% of the average: 10% is 3 sd. Two
-    // oracle runs gave 1.208 and 1.278 (green 1.392, 1.489) against the exact 1.25 1.45
-    // 1.65, which ours reproduces (its strata split each such bin evenly).
+    // one glow (the up window, 2 2.5 3), within 1e-4 for the ring (both 2.3998..), and within 13% for the
+    // side window, half sky half ground: 12 of its rays straddle the horizon and go to sky
+    // or ground at random in Radiance (unseeded), so its average is the exact one plus
+    // k/108 of the sky-ground difference with k = Binomial(12, 1/2) - 6 (10000 seeds of the
+    // oracle: sd 1.73, range exactly -6..6): 2.6% sd in blue, and k = -6 gives 1.50 against
+    // 1.65, 0.09999999999999987 below, which a 10% limit passed only by rounding. 13% is 5
+    // sd and covers every k. Ours gives the exact 1.25 1.45 1.65 (its strata split each
+    // such bin evenly).
     let Some(o) = common::oracle() else { return };
     let root = common::scratch("mkillum-directives");
     let mut outs = Vec::new();
@@ -132,7 +134,7 @@ fn oracle_directives_and_layout() {
     // up window, side window, ring; the sphere stays as it was (b=100 still applies)
     assert_eq!(a.len(), 3, "{a:?}");
     assert_eq!(a.len(), b.len());
-    let tol = [1e-5, 0.10, 1e-4];
+    let tol = [1e-5, 0.13, 1e-4];
     for ((x, y), t) in a.iter().zip(&b).zip(tol) {
         for k in 0..3 {
             assert!((x[k] / y[k] - 1.0).abs() <= t, "{x:?} vs {y:?}");
