@@ -11,29 +11,6 @@ fn tail(b: &[u8]) -> String {
     s.split_once('\n').map(|x| x.1).unwrap_or("").to_string()
 }
 
-/// Equal text, except that a number may differ by one unit in its last printed
-/// digit: the illuminance→irradiance iteration (-L) converges to within an ulp
-/// of the reference, which can move the 6th decimal of a Perez coefficient.
-fn same_to_printed_digits(a: &str, b: &str) -> bool {
-    let (wa, wb): (Vec<&str>, Vec<&str>) = (
-        a.split_whitespace().collect(),
-        b.split_whitespace().collect(),
-    );
-    wa.len() == wb.len()
-        && wa.iter().zip(&wb).all(|(x, y)| {
-            if x == y {
-                return true;
-            }
-            match (x.parse::<f64>(), y.parse::<f64>()) {
-                (Ok(p), Ok(q)) => {
-                    let decimals = x.split('.').nth(1).map(|d| d.len()).unwrap_or(0);
-                    !x.contains('e') && (p - q).abs() <= 1.000001 * 10f64.powi(-(decimals as i32))
-                }
-                _ => false,
-            }
-        })
-}
-
 struct Lcg(u64);
 impl Lcg {
     fn next(&mut self) -> f64 {
@@ -98,6 +75,13 @@ fn cases() -> Vec<Vec<String>> {
         "5 5 10 -P 13 0.3",
         "-ang 89 20 -W 500 100",
         "5 5 10 -W 100 -5",
+        // -L where the clearness cycles between two Perez categories (Radiance stops
+        // after 9 iterations, not at a fixed point) and a sun at the horizon (a direct
+        // efficacy below 0.1 lm/W gives no direct irradiance)
+        "8 17 17 -a 64 -o 21 -m 0 -L 80000 15000",
+        "7 27 16.75 -a -33.9 -o -151.2 -m -150 -L 5000 40000 -y 2024",
+        "-ang 0.3 165.35 -L 80000 15000 -y 2024",
+        "-ang 0.3 143.42 -L 5000 40000 -O 2",
     ] {
         v.push(c.split_whitespace().map(str::to_string).collect());
     }
@@ -113,7 +97,9 @@ fn oracle_gendaylit_generated_cases() {
         let want = o.command("gendaylit").args(a).output().unwrap();
         let got = common::fenestra("gendaylit").args(a).output().unwrap();
         let (w, g) = (tail(&want.stdout), tail(&got.stdout));
-        if !same_to_printed_digits(&w, &g) {
+        // identical text (before the -L iteration stopped at 9 as Radiance's, a -L case
+        // could differ by a unit in its last digit, or by a category)
+        if w != g {
             bad.push(format!("{}\n--- oracle\n{w}--- ours\n{g}", a.join(" ")));
         }
     }

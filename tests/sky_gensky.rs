@@ -99,7 +99,14 @@ fn generated_cases() -> Vec<Vec<String>> {
             5 => a.extend(["-r".into(), format!("{:.4e}", r.next() * 1e7)]),
             _ => {
                 if k % 12 != 0 {
-                    a.extend(["-y".into(), format!("{}", 1960 + (r.next() * 80.0) as i32)]);
+                    // mostly 1960-2039; every fifth outside 1950-2050 (1600-2999), where
+                    // Radiance's almanac day count leaves the Gregorian calendar
+                    let y = if k % 5 == 0 {
+                        1600 + (r.next() * 1400.0) as i32
+                    } else {
+                        1960 + (r.next() * 80.0) as i32
+                    };
+                    a.extend(["-y".into(), y.to_string()]);
                 }
             }
         }

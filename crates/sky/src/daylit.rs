@@ -328,18 +328,18 @@ pub fn compute(
             m.eps = m.clearness(dir_irr, dif_irr);
             m.delta = m.brightness(dif_irr);
             check_param(&mut m)?;
-            // iterate irradiance <-> illuminance to convergence (the reference
-            // build's results equal the converged values)
-            for _ in 0..100 {
-                let (old_dif, old_dir) = (dif_irr, dir_irr);
+            // irradiance from illuminance through the efficacies, exactly 9 times as
+            // Radiance's gendaylit (its stop test never holds once the parameters are
+            // clamped, so it ends at its counter): where the clearness flips between two
+            // Perez categories the values cycle and the ninth is the one printed. A direct
+            // efficacy below 0.1 lm/W (a sun at the horizon) gives no direct irradiance.
+            for _ in 0..9 {
                 dif_irr = dif_ill / m.diffuse_eff();
-                dir_irr = dir_ill / m.direct_eff();
+                let d_eff = m.direct_eff();
+                dir_irr = if d_eff < 0.1 { 0.0 } else { dir_ill / d_eff };
                 m.delta = m.brightness(dif_irr);
                 m.eps = m.clearness(dir_irr, dif_irr);
                 check_param(&mut m)?;
-                if dif_irr == old_dif && dir_irr == old_dir {
-                    break;
-                }
             }
             check_param(&mut m)?;
         }

@@ -129,15 +129,18 @@ impl Site {
     }
 }
 
-/// Days from 2000-01-01 to a civil date (proleptic Gregorian).
+/// Days from 2000-01-01 to a date as Radiance's almanac count does it: the day of the year,
+/// a leap day whenever the year is divisible by 4, and (year − 1949) × 365 + (year − 1949)/4
+/// (C's division, toward zero) days before. It is the calendar for 1901–2099; outside, where
+/// Radiance warns that its formula is out of range, it is kept so that positions agree with
+/// Radiance's (1900: a day from the Gregorian date).
 fn days_from_civil(y: i32, m: i32, d: i32) -> i64 {
-    let y = i64::from(if m <= 2 { y - 1 } else { y });
-    let era = y.div_euclid(400);
-    let yoe = y - era * 400;
-    let mp = i64::from((m + 9) % 12);
-    let doy = (153 * mp + 2) / 5 + i64::from(d) - 1;
-    let doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
-    era * 146097 + doe - 719468 - 10957
+    const MONTH_START: [i64; 12] = [0, 31, 59, 90, 120, 151, 181, 212, 243, 273, 304, 334];
+    let m = m.clamp(1, 12);
+    let leap = i64::from(m > 2 && y & 3 == 0);
+    let since = i64::from(y) - 1949;
+    // Radiance's Julian-date origin is 2432916.5 (1948-12-31 00:00 UT); J2000 is 2451545.
+    MONTH_START[(m - 1) as usize] + i64::from(d) + leap + since * 365 + since / 4 - 18628
 }
 
 /// A computed solar position.
@@ -173,6 +176,12 @@ mod tests {
         assert_eq!(julian_day(12, 31), 365);
         assert_eq!(days_from_civil(2000, 1, 1), 0);
         assert_eq!(days_from_civil(2000, 3, 1), 60);
+        // Radiance's almanac count: 2100 has a leap day, 1900 is counted from 1949 by truncation
+        assert_eq!(
+            days_from_civil(2100, 3, 1) - days_from_civil(2100, 2, 28),
+            2
+        );
+        assert_eq!(days_from_civil(1949, 1, 1), -18627);
     }
 
     #[test]
