@@ -316,11 +316,15 @@ fn bad_input_fails_cleanly() {
         ("m23h.txt + -t m23h.txt", "mismatched"),
         ("-c 1 2 m23h.txt", "coefficients"),
         ("-s 1 2 m23h.txt", "one factor"),
-        ("m23h.txt +", "after the last matrix"),
+        (
+            "m23h.txt +",
+            "missing matrix argument after the last operator",
+        ),
+        ("m23h.txt -R x.rep", "-R after the last matrix"),
         ("-fx m23h.txt", "unknown output format"),
         ("-fc -c 1 1 1 1 1 1 m23h.txt", "RGBE"),
         ("-rf missing.xml", "missing.xml"),
-        ("m23h.txt / m23h.txt", "not supported"),
+        ("-E e.err -R x.rep m23h.txt / m23h.txt", "not '/'"),
     ] {
         let out = run(
             common::fenestra("rmtxop"),
@@ -498,4 +502,80 @@ fn chain_without_nrows_matches_stored_dctimestep() {
         .fold(0.0, f64::max);
     eprintln!("V·T·D·s vs stored dctimestep: max relative difference {worst:.1e}");
     assert!(worst < 2e-6, "{worst}");
+}
+
+/// Radiance 6's rules found by a differential sweep: `-t -s -c` after the last matrix apply
+/// to the result, a one-component right operand of `*` or `/` multiplies (divides) every
+/// component, a command of products alone is multiplied from the right where Radiance's
+/// rule prefers it (a one-column or narrow rightmost matrix), and `/` gives 0 for a zero
+/// divisor with a warning line in the header. Byte-identical, except `/`: fenestra keeps
+/// single-precision values and Radiance double, so a quotient can differ by one unit in
+/// its 8th printed digit (2e-7 relative allowed).
+#[test]
+fn oracle_trailing_ops_broadcast_chain_order_division() {
+    let Some(o) = common::oracle() else { return };
+    let dir = common::scratch("rmtxop-rules");
+    let mut rnd = common::xorshift(17);
+    let mut write = |name: &str, r: usize, c: usize, n: usize, zero: bool| {
+        let mut t = format!("#?RADIANCE\nNROWS={r}\nNCOLS={c}\nNCOMP={n}\nFORMAT=ascii\n\n");
+        for i in 0..r {
+            let row: Vec<String> = (0..c * n)
+                .map(|k| {
+                    if zero && i == 0 && k == 0 {
+                        "0".to_string()
+                    } else {
+                        format!("{:.6}", rnd() * 3.0 - 1.0)
+                    }
+                })
+                .collect();
+            t += &(row.join(" ") + "\n");
+        }
+        std::fs::write(dir.join(name), t).unwrap();
+    };
+    write("A.mtx", 5, 7, 3, false);
+    write("B.mtx", 7, 4, 3, false);
+    write("E.mtx", 4, 4, 3, false);
+    write("W.mtx", 4, 9, 3, false);
+    write("v.mtx", 4, 1, 3, false);
+    write("F1.mtx", 5, 7, 1, false);
+    write("C.mtx", 5, 7, 3, false);
+    write("Z.mtx", 5, 7, 3, true);
+    for case in [
+        "-fa A.mtx -t",
+        "-fa A.mtx B.mtx -c 1 0 0",
+        "-fa A.mtx + C.mtx -s 2 -t",
+        "-fa A.mtx * F1.mtx",
+        "-fa A.mtx . B.mtx . E.mtx",
+        "-fa A.mtx . B.mtx . v.mtx",
+        "-fa A.mtx . B.mtx . W.mtx",
+        "-fa A.mtx . B.mtx + C.mtx -t . A.mtx",
+    ] {
+        same_as_oracle(&o, &dir, case);
+    }
+    for case in [
+        "-fa A.mtx / F1.mtx",
+        "-fa A.mtx / C.mtx",
+        "-fa A.mtx / Z.mtx",
+    ] {
+        let a = words(case);
+        let theirs = run(o.command("rmtxop"), &dir, &a);
+        let ours = run(common::fenestra("rmtxop"), &dir, &a);
+        assert!(theirs.status.success() && ours.status.success(), "{case}");
+        let split = |b: &[u8]| {
+            let s = String::from_utf8_lossy(b).into_owned();
+            let (h, d) = s.split_once("\n\n").unwrap();
+            (h.to_string(), common::numbers(d.as_bytes()))
+        };
+        let ((th, tv), (oh, ov)) = (split(&theirs.stdout), split(&ours.stdout));
+        assert_eq!(th, oh, "{case}: header");
+        common::agree(case, &tv, &ov, 2e-7, 1e-30);
+        if case.contains("Z.mtx") {
+            assert!(
+                oh.contains("WARNING: zero divide(s) corrupted results"),
+                "{oh}"
+            );
+            assert!(String::from_utf8_lossy(&ours.stderr).contains("element-wise division"));
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }

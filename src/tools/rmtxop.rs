@@ -8,7 +8,9 @@ use anyhow::{bail, Context, Result};
 use fenestra_cli::opts::parse_real;
 use fenestra_dc::ops::{is_xml, Mtx, Source, XmlPart};
 use fenestra_dc::ops_errors::Tracked;
-use fenestra_dc::rmtxop::{evaluate, load, load_from, load_tracked, propagate, Input, Op};
+use fenestra_dc::rmtxop::{
+    apply_own, evaluate, load, load_from, load_tracked, propagate, Input, Op,
+};
 use fenestra_formats::header::Header;
 use fenestra_formats::matrix::{AsciiLayout, DataFormat, MatrixWriter, WriteOptions};
 
@@ -45,6 +47,8 @@ struct Parsed {
     errors: Option<String>,
     format: Option<DataFormat>,
     inputs: Vec<Input>,
+    /// `-t -s -c` after the last matrix: applied to the result.
+    trailing: Option<Input>,
 }
 
 fn parse(args: &[String]) -> Result<Parsed> {
@@ -82,18 +86,16 @@ fn parse(args: &[String]) -> Result<Parsed> {
                 print!("{HELP}");
                 return Err(fenestra_cli::Exit(0).into());
             }
-            "." | "+" | "*" => {
+            "." | "+" | "*" | "/" => {
                 if inputs.is_empty() || op.is_some() {
                     bail!("operator '{a}' must stand between two matrices\n{USAGE}");
                 }
                 op = Some(match a {
                     "." => Op::Product,
                     "+" => Op::Sum,
-                    _ => Op::ElemProduct,
+                    "*" => Op::ElemProduct,
+                    _ => Op::ElemQuotient,
                 });
-            }
-            "/" => {
-                bail!("operator '/' (element-wise division) is not supported by fenestra's rmtxop")
             }
             "-v" => verbose = true,
             "-t" => transpose = !transpose,
@@ -150,8 +152,26 @@ fn parse(args: &[String]) -> Result<Parsed> {
     if inputs.is_empty() {
         bail!("no input matrix\n{USAGE}");
     }
-    if op.is_some() || transpose || scale.is_some() || cmat.is_some() || replicas.is_some() {
-        bail!("operator or option after the last matrix\n{USAGE}");
+    if op.is_some() {
+        bail!("missing matrix argument after the last operator\n{USAGE}");
+    }
+    if replicas.is_some() {
+        bail!(
+            "-R after the last matrix: it names the replicas of the matrix that follows\n{USAGE}"
+        );
+    }
+    // -t, -s and -c after the last matrix apply to the result (Radiance's trailing ops)
+    let trailing = (transpose || scale.is_some() || cmat.is_some()).then(|| Input {
+        name: "trailing_ops".into(),
+        op: Op::Product,
+        transpose,
+        scale,
+        cmat,
+        part: XmlPart::Transmission,
+        replicas: None,
+    });
+    if errors.is_some() && inputs.iter().any(|i| i.op == Op::ElemQuotient) {
+        bail!("-E carries errors through '.', '+' and '*', not '/'\n{USAGE}");
     }
     let with_replicas = inputs.iter().any(|i| i.replicas.is_some());
     if errors.is_some() != with_replicas {
@@ -164,6 +184,7 @@ fn parse(args: &[String]) -> Result<Parsed> {
         errors,
         format,
         inputs,
+        trailing,
     })
 }
 
@@ -234,15 +255,22 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         for inp in &p.inputs {
             tracked.push(load_tracked(inp, p.verbose)?);
         }
-        let m = evaluate(
+        let mut m = evaluate(
             &p.inputs,
             tracked.iter().map(|t| t.value.clone()).collect(),
             p.verbose,
         )?;
+        if let Some(t) = &p.trailing {
+            apply_own(t, &mut m)?;
+        }
         write_errors(&p, e, tracked, &args)?;
         return write_result(&p, m, &args);
     }
-    if p.inputs.len() == 1 && !p.inputs[0].transpose && !is_xml(&p.inputs[0].name) {
+    if p.inputs.len() == 1
+        && p.trailing.is_none()
+        && !p.inputs[0].transpose
+        && !is_xml(&p.inputs[0].name)
+    {
         let src = Source::open(&p.inputs[0].name)?;
         let values = src
             .reader
@@ -259,7 +287,10 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     for inp in &p.inputs {
         mats.push(load(inp, p.verbose)?);
     }
-    let m = evaluate(&p.inputs, mats, p.verbose)?;
+    let mut m = evaluate(&p.inputs, mats, p.verbose)?;
+    if let Some(t) = &p.trailing {
+        apply_own(t, &mut m)?;
+    }
     write_result(&p, m, &args)
 }
 
@@ -267,7 +298,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
 /// every operation, [`propagate`]) written to `err` (the result itself is computed as
 /// without `-E`, so its bytes do not change).
 fn write_errors(p: &Parsed, err: &str, tracked: Vec<Tracked>, args: &[String]) -> Result<()> {
-    let se = propagate(&p.inputs, tracked)?;
+    let se = propagate(&p.inputs, tracked, p.trailing.as_ref())?;
     let mut opts = output_options(p, &se, args)?;
     if opts.format == DataFormat::Rgbe {
         opts.format = DataFormat::Ascii;

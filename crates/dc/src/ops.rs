@@ -391,11 +391,60 @@ impl Mtx {
         Ok(())
     }
 
-    /// Multiplies element by element (`*`).
+    /// Multiplies element by element (`*`); a one-component `other` multiplies every
+    /// component of its element, as Radiance's.
     pub fn elem_mul(&mut self, other: &Mtx) -> Result<()> {
+        if other.ncomp == 1 && self.ncomp > 1 {
+            self.same_size(other, "element-wise product")?;
+            let nc = self.ncomp;
+            for (a, &b) in self.data.chunks_exact_mut(nc).zip(&other.data) {
+                for x in a {
+                    *x = (*x as f64 * b as f64) as f32;
+                }
+            }
+            return Ok(());
+        }
         self.same_shape(other, "element-wise product")?;
         for (a, &b) in self.data.iter_mut().zip(&other.data) {
             *a = (*a as f64 * b as f64) as f32;
+        }
+        Ok(())
+    }
+
+    /// Divides element by element (`/`), a one-component `other` dividing every component
+    /// of its element; a zero divisor gives 0 (Radiance's rule). Returns how many did.
+    pub fn elem_div(&mut self, other: &Mtx) -> Result<usize> {
+        let nc = self.ncomp;
+        let per = if other.ncomp == 1 && nc > 1 {
+            self.same_size(other, "element-wise division")?;
+            nc
+        } else {
+            self.same_shape(other, "element-wise division")?;
+            1
+        };
+        let mut zeros = 0;
+        for (a, &b) in self.data.chunks_exact_mut(per).zip(&other.data) {
+            for x in a {
+                if b == 0.0 {
+                    zeros += 1;
+                    *x = 0.0;
+                } else {
+                    *x = (*x as f64 / b as f64) as f32;
+                }
+            }
+        }
+        Ok(zeros)
+    }
+
+    fn same_size(&self, other: &Mtx, what: &str) -> Result<()> {
+        if (self.nrows, self.ncols) != (other.nrows, other.ncols) {
+            bail!(
+                "{what} of mismatched matrices: {}×{} and {}×{} (rows × columns)",
+                self.nrows,
+                self.ncols,
+                other.nrows,
+                other.ncols
+            );
         }
         Ok(())
     }
@@ -464,31 +513,43 @@ impl Mtx {
     }
 }
 
-/// Multiplies a chain of matrices, choosing the order as Radiance's rmtxop does: the
-/// adjacent pair cheapest to multiply (rows × inner × columns) goes first, repeatedly
-/// (the order changes the single-precision rounding of the result).
-pub fn multiply_chain(mut chain: Vec<Mtx>) -> Result<Mtx> {
+/// Whether Radiance's rmtxop multiplies a chain of three or more matrices from the right:
+/// when the rightmost has one column, or fewer columns than rows and than the leftmost
+/// has rows (the order changes the single-precision rounding of the result).
+pub fn prefer_right_to_left(chain: &[Mtx]) -> bool {
+    let (Some(first), Some(last)) = (chain.first(), chain.last()) else {
+        return false;
+    };
+    if chain.len() < 3 {
+        return false;
+    }
+    if last.ncols == 1 {
+        return true;
+    }
+    last.ncols < last.nrows && last.ncols < first.nrows
+}
+
+/// Multiplies a chain of matrices from the left, or from the right when `right_to_left`.
+pub fn multiply_chain(mut chain: Vec<Mtx>, right_to_left: bool) -> Result<Mtx> {
     for w in chain.windows(2) {
         if w[0].ncols != w[1].nrows || w[0].ncomp != w[1].ncomp {
             // Report the first mismatch in command-line order.
             w[0].multiply_check(&w[1])?;
         }
     }
-    while chain.len() > 1 {
-        let mut best = 0;
-        let mut best_cost = u128::MAX;
-        for (i, w) in chain.windows(2).enumerate() {
-            let cost = w[0].nrows as u128 * w[0].ncols as u128 * w[1].ncols as u128;
-            if cost < best_cost {
-                best_cost = cost;
-                best = i;
-            }
+    if right_to_left {
+        let mut acc = chain.pop().context("empty matrix chain")?;
+        while let Some(m) = chain.pop() {
+            acc = m.multiply(&acc)?;
         }
-        let b = chain.remove(best + 1);
-        let p = chain[best].multiply(&b)?;
-        chain[best] = p;
+        return Ok(acc);
     }
-    chain.pop().context("empty matrix chain")
+    let mut it = chain.into_iter();
+    let mut acc = it.next().context("empty matrix chain")?;
+    for m in it {
+        acc = acc.multiply(&m)?;
+    }
+    Ok(acc)
 }
 
 #[cfg(test)]

@@ -4,7 +4,7 @@
 
 use anyhow::{bail, Context, Result};
 
-use crate::ops::{is_xml, multiply_chain, Mtx, Source, XmlPart};
+use crate::ops::{is_xml, multiply_chain, prefer_right_to_left, Mtx, Source, XmlPart};
 use crate::ops_errors::Tracked;
 
 /// What joins a matrix to the result so far.
@@ -16,6 +16,8 @@ pub enum Op {
     Sum,
     /// `*`: element-wise product.
     ElemProduct,
+    /// `/`: element-wise division.
+    ElemQuotient,
 }
 
 /// One input with the options given before it.
@@ -58,7 +60,7 @@ fn report(inp: &Input, m: &Mtx, verbose: bool) {
 }
 
 /// Applies an input's own options (`-s`/`-c`, then `-t`) to a matrix of it.
-fn apply_own(inp: &Input, m: &mut Mtx) -> Result<()> {
+pub fn apply_own(inp: &Input, m: &mut Mtx) -> Result<()> {
     if inp.cmat.is_some() || inp.scale.is_some() {
         m.transform(inp.cmat.as_deref(), inp.scale.as_deref())
             .with_context(|| inp.name.clone())?;
@@ -84,20 +86,33 @@ pub fn load_from(inp: &Input, src: Source, verbose: bool) -> Result<Mtx> {
     Ok(m)
 }
 
-/// The result of the loaded inputs `mats` (their own options applied): left to right, a
-/// run of products multiplied as one chain (cheapest pair first).
+/// The result of the loaded inputs `mats` (their own options applied): left to right, as
+/// Radiance's rmtxop, except that a command of products alone (three or more) is multiplied
+/// from the right where Radiance's rule prefers that ([`prefer_right_to_left`]).
 pub fn evaluate(inputs: &[Input], mats: Vec<Mtx>, verbose: bool) -> Result<Mtx> {
+    let right_to_left =
+        inputs.iter().skip(1).all(|i| i.op == Op::Product) && prefer_right_to_left(&mats);
     let mut chain: Vec<(Mtx, String)> = Vec::new();
     for (inp, m) in inputs.iter().zip(mats) {
         if inp.op == Op::Product || chain.is_empty() {
             chain.push((m, inp.name.clone()));
             continue;
         }
-        let mut acc = reduce_chain(std::mem::take(&mut chain), verbose)?;
+        let mut acc = reduce_chain(std::mem::take(&mut chain), verbose, false)?;
         match inp.op {
             Op::Sum => acc
                 .add(&m)
                 .with_context(|| format!("{}: matrix sum failed", inp.name))?,
+            Op::ElemQuotient => {
+                let zeros = acc
+                    .elem_div(&m)
+                    .with_context(|| format!("{}: element-wise division failed", inp.name))?;
+                if zeros > 0 {
+                    acc.info
+                        .push("WARNING: zero divide(s) corrupted results".into());
+                    fenestra_cli::warn(format!("{}: error during element-wise division", inp.name));
+                }
+            }
             _ => acc
                 .elem_mul(&m)
                 .with_context(|| format!("{}: element-wise product failed", inp.name))?,
@@ -107,7 +122,7 @@ pub fn evaluate(inputs: &[Input], mats: Vec<Mtx>, verbose: bool) -> Result<Mtx> 
         }
         chain.push((acc, String::new()));
     }
-    reduce_chain(chain, verbose)
+    reduce_chain(chain, verbose, right_to_left)
 }
 
 /// One input with its replicas (`-R`) as a tracked matrix, its own options applied to the
@@ -137,8 +152,9 @@ pub fn load_tracked(inp: &Input, verbose: bool) -> Result<Tracked> {
 }
 
 /// The standard errors of the result: the tracked inputs combined left to right (products
-/// too), each operation applied to the value and to every replica deviation.
-pub fn propagate(inputs: &[Input], tracked: Vec<Tracked>) -> Result<Mtx> {
+/// too), each operation applied to the value and to every replica deviation, then the
+/// `trailing` options (`-t -s -c` after the last matrix), if any.
+pub fn propagate(inputs: &[Input], tracked: Vec<Tracked>, trailing: Option<&Input>) -> Result<Mtx> {
     let mut acc: Option<Tracked> = None;
     for (inp, t) in inputs.iter().zip(tracked) {
         acc = Some(match acc {
@@ -150,18 +166,27 @@ pub fn propagate(inputs: &[Input], tracked: Vec<Tracked>) -> Result<Mtx> {
                 Op::Sum => a
                     .sum(t)
                     .with_context(|| format!("{}: matrix sum failed", inp.name))?,
+                Op::ElemQuotient => {
+                    bail!(
+                        "{}: -E carries errors through '.', '+' and '*', not '/'",
+                        inp.name
+                    )
+                }
                 Op::ElemProduct => a
                     .elem_mul(&t)
                     .with_context(|| format!("{}: element-wise product failed", inp.name))?,
             },
         });
     }
-    let t = acc.context("no input matrix")?;
+    let mut t = acc.context("no input matrix")?;
+    if let Some(tr) = trailing {
+        t.map(|m| apply_own(tr, m))?;
+    }
     Ok(t.standard_errors())
 }
 
 /// Multiplies a chain of loaded matrices (a single matrix is returned as is).
-fn reduce_chain(chain: Vec<(Mtx, String)>, verbose: bool) -> Result<Mtx> {
+fn reduce_chain(chain: Vec<(Mtx, String)>, verbose: bool, right_to_left: bool) -> Result<Mtx> {
     let names: Vec<String> = chain.iter().map(|c| c.1.clone()).collect();
     let mats: Vec<Mtx> = chain.into_iter().map(|c| c.0).collect();
     if mats.len() > 1 {
@@ -169,7 +194,8 @@ fn reduce_chain(chain: Vec<(Mtx, String)>, verbose: bool) -> Result<Mtx> {
             eprintln!("rmtxop: multiplying {} matrices", mats.len());
         }
         let last = names.last().cloned().unwrap_or_default();
-        return multiply_chain(mats).with_context(|| format!("{last}: matrix product failed"));
+        return multiply_chain(mats, right_to_left)
+            .with_context(|| format!("{last}: matrix product failed"));
     }
     mats.into_iter().next().context("no input matrix")
 }
