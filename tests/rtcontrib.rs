@@ -388,6 +388,10 @@ fn command_line_errors() {
             "illegal non-zero constant for bin (2)",
         ),
         (
+            vec!["-b", "0.6", "-m", "skyglow"],
+            "illegal non-zero constant for bin (0.6)",
+        ),
+        (
             vec!["-b", "Dz", "-m", "skyglow"],
             "unspecified or illegal bin count for modifier 'skyglow'",
         ),
@@ -1572,4 +1576,24 @@ fn recover_after_killing_a_run() {
     assert!(data_part(&part) == data_part(&full), "-r records differ");
     assert!(!partial.exists());
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A constant bin expression (none, `-b 0`, or any number Radiance rounds to bin 0, as
+/// `(int)(v + 1.5) = 1`) is one bin whatever `-bn` says, as Radiance's rcontrib writes it
+/// (found by a differential sweep: fenestra wrote the `-bn` count, zeros after the first).
+#[test]
+fn constant_bin_is_one_bin_whatever_bn_says() {
+    let sky = fx("sky_uniform.rad");
+    for b in [&[][..], &["-b", "0"], &["-b", "0.3"], &["-b", "-0.4"]] {
+        let mut a: Vec<&str> = vec!["-h", "-ab", "0"];
+        a.extend_from_slice(b);
+        a.extend_from_slice(&["-bn", "4", "-m", "skyglow", &sky]);
+        let o = run_in(rc(&a), b"0 0 0 0 0 1\n");
+        assert!(
+            o.status.success(),
+            "{b:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert_eq!(common::numbers(&o.stdout).len(), 3, "{b:?}");
+    }
 }

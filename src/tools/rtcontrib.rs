@@ -5,7 +5,7 @@
 use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
-use fenestra_contrib::bins::{is_zero_constant, parse_params, BinRequest, Bins, CalcDefs};
+use fenestra_contrib::bins::{is_constant_bin, parse_params, BinRequest, Bins, CalcDefs};
 use fenestra_contrib::engine::{Engine, InFormat, InputRay, RayInput, RunOptions, Tracked};
 use fenestra_contrib::output::{self, Format, HeaderInfo, ModOut, Spec, Stream};
 use fenestra_contrib::run as contrib_run;
@@ -108,15 +108,14 @@ pub fn run_with(
         if mods.iter().any(|m| m.name == name) {
             bail!("duplicate modifier '{name}'");
         }
-        let konst = fenestra_cli::opts::parse_real(bin.trim());
-        if let Some(k) = konst {
-            if k != 0.0 {
-                bail!("illegal non-zero constant for bin ({bin})");
-            }
+        // a constant bin (a number) is one bin whatever -bn says, as Radiance's; its value
+        // rounded as (int)(v + 1.5) must give one bin
+        if fenestra_cli::opts::parse_real(bin.trim()).is_some() && !is_constant_bin(bin) {
+            bail!("illegal non-zero constant for bin ({bin})");
         }
         let (nbins, dynamic) = match nb {
+            _ if is_constant_bin(bin) => (1, false),
             Some(n) if n > 0 => (n, false),
-            None if is_zero_constant(bin) => (1, false),
             // the older rtcontrib: -bn optional, the count is what the bins reach
             None if legacy => (1, true),
             _ => bail!("unspecified or illegal bin count for modifier '{name}'"),

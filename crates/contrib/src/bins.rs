@@ -228,9 +228,10 @@ pub struct BinRequest<'a> {
     pub params: &'a [(String, f64)],
 }
 
-/// Whether a bin expression is the constant zero (no evaluation needed).
-pub fn is_zero_constant(expr: &str) -> bool {
-    fenestra_cli::opts::parse_real(expr.trim()) == Some(0.0)
+/// Whether a bin expression is a number that Radiance takes as bin 0 (its value v with
+/// (int)(v + 1.5) = 1, i.e. −0.5 ≤ v < 0.5): one bin, nothing to evaluate.
+pub fn is_constant_bin(expr: &str) -> bool {
+    fenestra_cli::opts::parse_real(expr.trim()).is_some_and(|v| (v + 1.5).trunc() == 1.0)
 }
 
 impl Bins {
@@ -240,7 +241,7 @@ impl Bins {
         let mut progs: Vec<(Program, Vec<VarId>)> = Vec::new();
         let mut placed: Vec<Option<(usize, ExprId)>> = Vec::new();
         for r in reqs {
-            if is_zero_constant(r.expr) {
+            if is_constant_bin(r.expr) {
                 placed.push(None);
                 continue;
             }
