@@ -248,6 +248,9 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             );
         }
     }
+    if (irr || irr_hit) && !outspec.chars().any(|c| "rRxXvVlnW".contains(c)) {
+        bail!("-I+ and -i+ options require some value output");
+    }
     if !tracer.emits() && !outspec.chars().all(|c| "odlLpnN".contains(c)) {
         fenestra_cli::warn("no light sources found (nothing in the scene emits light)");
     }
@@ -257,7 +260,20 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     if header {
         let mut h = String::from("#?RADIANCE\n");
         h.push_str(&fenestra_cli::command_line(&args));
-        h.push_str("\nSOFTWARE= fenestra\nNCOMP=3\n");
+        h.push_str("\nSOFTWARE= fenestra\n");
+        // numbers per record, as Radiance counts them
+        let ncomp: usize = outspec
+            .chars()
+            .map(|c| match c {
+                'o' | 'd' | 'v' | 'V' | 'p' | 'n' | 'N' | 'W' | 'r' | 'x' => 3,
+                'c' => 2,
+                '~' => 0,
+                _ => 1,
+            })
+            .sum();
+        if ncomp > 0 {
+            h.push_str(&format!("NCOMP={ncomp}\n"));
+        }
         h.push_str(match fout {
             Fmt::Ascii => "FORMAT=ascii\n",
             Fmt::Float => "FORMAT=float\n",
@@ -307,6 +323,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
                 'w' => rec.push(1.0),
                 'l' | 'L' => rec.push(hit.map_or(0.0, |h| h.t)),
                 'p' => rec.extend(hit.map_or([0.0; 3], |h| h.point.to_array())),
+                'N' => rec.extend(hit.map_or([0.0; 3], |h| h.geometric.to_array())),
                 _ => rec.extend(hit.map_or([0.0; 3], |h| h.normal.to_array())),
             }
         }

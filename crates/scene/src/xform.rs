@@ -144,9 +144,13 @@ impl XformOptions {
             .filter(|(_, w)| *w == "-a")
             .map(|(k, _)| {
                 let w = &self.xf_words[k + 1];
+                // a count of 0 is an error, as Radiance's "missing count for -a option"
                 parse_count(w)
+                    .filter(|&n| n > 0)
                     .map(|n| (k, n))
-                    .ok_or_else(|| anyhow!("-a: expected a count, got '{w}'"))
+                    .ok_or_else(|| {
+                        anyhow!("missing count for -a option: expected a positive count, got '{w}'")
+                    })
             })
             .collect::<Result<_>>()?;
         let total = if arrays.is_empty() {

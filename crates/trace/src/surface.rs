@@ -41,6 +41,7 @@ pub fn shape_of(p: &Primitive) -> Result<Built> {
             p.loc, p.ptype, p.name
         )))
     };
+    let mut warn = None;
     let shape = match p.ptype.as_str() {
         "polygon" => {
             if r.len() % 3 != 0 {
@@ -63,7 +64,6 @@ pub fn shape_of(p: &Primitive) -> Result<Built> {
                 return Err(bad("radius is not a finite number"));
             }
             let mut inward = p.ptype == "bubble";
-            let mut warn = None;
             if r[3] < -FTINY {
                 inward = !inward;
                 warn = Some(format!(
@@ -94,19 +94,40 @@ pub fn shape_of(p: &Primitive) -> Result<Built> {
             let p1 = DVec3::new(r[3], r[4], r[5]);
             let (r0, r1) = if cyl { (r[6], r[6]) } else { (r[6], r[7]) };
             let len = (p1 - p0).length();
-            if len <= 0.0 || r0 < 0.0 || r1 < 0.0 || (r0 == 0.0 && r1 == 0.0) {
+            // Radiance's rules: a radius within FTINY of 0 is 0; both 0, or of opposite
+            // signs, is degenerate; a negative radius turns the surface inside out (cone ↔
+            // cup, cylinder ↔ tube) with a warning and is taken as its magnitude
+            let (s0, s1) = (sign(r0), sign(r1));
+            if !(len > 0.0) || s0 + s1 == 0 || !r0.is_finite() || !r1.is_finite() {
                 return Ok(Built::Ignored(format!(
                     "{}: {} '{}' is degenerate; ignored",
                     p.loc, p.ptype, p.name
                 )));
             }
+            let mut inward = p.ptype == "cup" || p.ptype == "tube";
+            if s0 < 0 || s1 < 0 {
+                inward = !inward;
+                warn = Some(format!(
+                    "{}: {} '{}': negative radi{} (taken as a {})",
+                    p.loc,
+                    p.ptype,
+                    p.name,
+                    if cyl { "us" } else { "i" },
+                    match (cyl, inward) {
+                        (true, true) => "tube",
+                        (true, false) => "cylinder",
+                        (false, true) => "cup",
+                        (false, false) => "cone",
+                    }
+                ));
+            }
             Shape::Cone {
                 p0,
                 axis: (p1 - p0) / len,
                 len,
-                r0,
-                r1,
-                inward: p.ptype == "cup" || p.ptype == "tube",
+                r0: r0.abs() * f64::from(s0.abs()),
+                r1: r1.abs() * f64::from(s1.abs()),
+                inward,
             }
         }
         "ring" => {
@@ -114,7 +135,11 @@ pub fn shape_of(p: &Primitive) -> Result<Built> {
                 return Err(bad("needs 8 real arguments"));
             }
             let n = DVec3::new(r[3], r[4], r[5]);
-            if n.length() == 0.0 || r[6] < 0.0 || r[7] <= r[6] {
+            // Radiance's rules: radii within FTINY of 0 are 0, a negative one or two equal
+            // ones are degenerate, and the larger is the outer whichever comes first
+            let (s0, s1) = (sign(r[6]), sign(r[7]));
+            let (r0, r1) = (r[6] * f64::from(s0), r[7] * f64::from(s1));
+            if !(n.length() > 0.0) || s0 < 0 || s1 < 0 || (r0 - r1).abs() <= FTINY {
                 return Ok(Built::Ignored(format!(
                     "{}: ring '{}' is degenerate; ignored",
                     p.loc, p.name
@@ -123,11 +148,22 @@ pub fn shape_of(p: &Primitive) -> Result<Built> {
             Shape::Ring {
                 c: DVec3::new(r[0], r[1], r[2]),
                 n: n.normalize(),
-                r0: r[6],
-                r1: r[7],
+                r0: r0.min(r1),
+                r1: r0.max(r1),
             }
         }
         other => return Err(bad(&format!("'{other}' is not a geometry type"))),
     };
-    Ok(Built::Shape(shape, None))
+    Ok(Built::Shape(shape, warn))
+}
+
+/// The sign of a radius as Radiance reads it: 0 within FTINY of 0 (NaN counts as 0).
+fn sign(x: f64) -> i32 {
+    if x < -FTINY {
+        -1
+    } else if x > FTINY {
+        1
+    } else {
+        0
+    }
 }

@@ -2,7 +2,8 @@
 //! inputs `ri(n) gi(n) bi(n) li(n)` with optional pixel offsets `ri(n, dx, dy)`
 //! (`n = 0` gives the number of inputs), `le(n)` input exposure, `pa(n)` pixel aspect,
 //! position `x y` (y up from the bottom), sizes `xres yres` (output) and `xmax ymax`
-//! (inputs), `WE` (179 lm/W) and `PI`, as Radiance's pcomb defines them.
+//! (inputs), `nfiles` (the number of inputs), `WE` (179 lm/W) and `PI`, as Radiance's pcomb
+//! defines them.
 
 use std::cell::Cell;
 use std::sync::Arc;
@@ -94,6 +95,7 @@ impl Exprs {
         p.set_number("ymax", ymax);
         p.set_number("xres", xres as f64);
         p.set_number("yres", yres as f64);
+        p.set_number("nfiles", inputs.len() as f64);
         p.set_number("WE", 179.0);
         p.set_number("PI", std::f64::consts::PI);
         for (name, chan) in [

@@ -223,8 +223,13 @@ pub struct FirstHit {
     /// Hit point (the origin when nothing was hit).
     pub point: DVec3,
     /// Surface normal as stored on the ray: geometric normal, flipped for materials that
-    /// face the ray (plastic, metal, trans, glass, mirror), as Radiance reports it.
+    /// face the ray (plastic, metal, trans, glass, mirror), as Radiance reports it (`-on`);
+    /// the reversed ray direction on a distant source, zero when nothing is hit.
     pub normal: DVec3,
+    /// The surface's own normal, not flipped toward the ray (`-oN`: outward for a sphere,
+    /// cylinder or cone, inward for a bubble, tube or cup, a polygon's by its winding);
+    /// the reversed ray direction on a distant source, zero when nothing is hit.
+    pub geometric: DVec3,
     /// Scene index of the surface, if any.
     pub prim: Option<usize>,
 }
@@ -239,7 +244,8 @@ impl Tracer {
         {
             Some(h) => {
                 let p = org + d * h.t;
-                let mut n = self.accel.shapes[h.shape].normal(p);
+                let g = self.accel.shapes[h.shape].normal(p);
+                let mut n = g;
                 if !self.mats[&self.surf_mat[h.shape]].is_light() && n.dot(d) > 0.0 {
                     n = -n;
                 }
@@ -247,15 +253,25 @@ impl Tracer {
                     t: h.t,
                     point: p,
                     normal: n,
+                    geometric: g,
                     prim: Some(self.surf_prim[h.shape]),
                 }
             }
-            None => FirstHit {
-                t: 1e10,
-                point: org,
-                normal: -d,
-                prim: None,
-            },
+            None => {
+                // a distant source faces the ray (Radiance's); nothing at all has no normal
+                let n = if d != DVec3::ZERO && self.find_distant(d).is_some() {
+                    -d
+                } else {
+                    DVec3::ZERO
+                };
+                FirstHit {
+                    t: 1e10,
+                    point: org,
+                    normal: n,
+                    geometric: n,
+                    prim: None,
+                }
+            }
         }
     }
 
