@@ -98,7 +98,7 @@ pub fn shape_of(p: &Primitive) -> Result<Built> {
             // signs, is degenerate; a negative radius turns the surface inside out (cone ↔
             // cup, cylinder ↔ tube) with a warning and is taken as its magnitude
             let (s0, s1) = (sign(r0), sign(r1));
-            if !(len > 0.0) || s0 + s1 == 0 || !r0.is_finite() || !r1.is_finite() {
+            if len.is_nan() || len <= 0.0 || s0 + s1 == 0 || !r0.is_finite() || !r1.is_finite() {
                 return Ok(Built::Ignored(format!(
                     "{}: {} '{}' is degenerate; ignored",
                     p.loc, p.ptype, p.name
@@ -139,7 +139,8 @@ pub fn shape_of(p: &Primitive) -> Result<Built> {
             // ones are degenerate, and the larger is the outer whichever comes first
             let (s0, s1) = (sign(r[6]), sign(r[7]));
             let (r0, r1) = (r[6] * f64::from(s0), r[7] * f64::from(s1));
-            if !(n.length() > 0.0) || s0 < 0 || s1 < 0 || (r0 - r1).abs() <= FTINY {
+            let nl = n.length();
+            if nl.is_nan() || nl <= 0.0 || s0 < 0 || s1 < 0 || (r0 - r1).abs() <= FTINY {
                 return Ok(Built::Ignored(format!(
                     "{}: ring '{}' is degenerate; ignored",
                     p.loc, p.name
