@@ -66,13 +66,8 @@ pub fn shape_of(p: &Primitive) -> Result<Built> {
             let mut inward = p.ptype == "bubble";
             if r[3] < -FTINY {
                 inward = !inward;
-                warn = Some(format!(
-                    "{}: {} '{}': negative radius (taken as a {})",
-                    p.loc,
-                    p.ptype,
-                    p.name,
-                    if inward { "bubble" } else { "sphere" }
-                ));
+                let taken = if inward { "bubble" } else { "sphere" };
+                warn = Some(inside_out(p, "radius", taken));
             } else if r[3] <= FTINY {
                 return ignored("zero radius");
             }
@@ -107,19 +102,13 @@ pub fn shape_of(p: &Primitive) -> Result<Built> {
             let mut inward = p.ptype == "cup" || p.ptype == "tube";
             if s0 < 0 || s1 < 0 {
                 inward = !inward;
-                warn = Some(format!(
-                    "{}: {} '{}': negative radi{} (taken as a {})",
-                    p.loc,
-                    p.ptype,
-                    p.name,
-                    if cyl { "us" } else { "i" },
-                    match (cyl, inward) {
-                        (true, true) => "tube",
-                        (true, false) => "cylinder",
-                        (false, true) => "cup",
-                        (false, false) => "cone",
-                    }
-                ));
+                let taken = match (cyl, inward) {
+                    (true, true) => "tube",
+                    (true, false) => "cylinder",
+                    (false, true) => "cup",
+                    (false, false) => "cone",
+                };
+                warn = Some(inside_out(p, if cyl { "radius" } else { "radii" }, taken));
             }
             Shape::Cone {
                 p0,
@@ -156,6 +145,14 @@ pub fn shape_of(p: &Primitive) -> Result<Built> {
         other => return Err(bad(&format!("'{other}' is not a geometry type"))),
     };
     Ok(Built::Shape(shape, warn))
+}
+
+/// The warning for a surface a negative radius turned inside out.
+fn inside_out(p: &Primitive, radius: &str, taken: &str) -> String {
+    format!(
+        "{}: {} '{}': negative {radius} (taken as a {taken})",
+        p.loc, p.ptype, p.name
+    )
 }
 
 /// The sign of a radius as Radiance reads it: 0 within FTINY of 0 (NaN counts as 0).
