@@ -552,6 +552,28 @@ fn oracle_trailing_ops_broadcast_chain_order_division() {
     ] {
         same_as_oracle(&o, &dir, case);
     }
+    // the broadcast with the one-component operand's replicas (-E): errors of A's shape
+    let mut rep =
+        String::from("#?RADIANCE\nNREPLICAS=2\nNROWS=10\nNCOLS=7\nNCOMP=1\nFORMAT=ascii\n\n");
+    for i in 0..10 {
+        let row: Vec<String> = (0..7)
+            .map(|k| format!("{}", 0.5 + 0.01 * (i * 7 + k) as f64))
+            .collect();
+        rep += &(row.join(" ") + "\n");
+    }
+    std::fs::write(dir.join("F1.rep"), rep).unwrap();
+    let out = run(
+        common::fenestra("rmtxop"),
+        &dir,
+        &words("-fa -E e.err A.mtx * -R F1.rep F1.mtx"),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let e = std::fs::read_to_string(dir.join("e.err")).unwrap();
+    assert!(e.contains("NCOMP=3\n"), "{e}");
     for case in [
         "-fa A.mtx / F1.mtx",
         "-fa A.mtx / C.mtx",

@@ -126,9 +126,10 @@ impl Tracked {
         for s in &other.sources {
             let mut v = Vec::with_capacity(s.len());
             for d in s {
-                let mut d = d.clone();
-                d.elem_mul(&self.value)?;
-                v.push(d);
+                // self ⊙ d (not d ⊙ self): a one-component right operand broadcasts
+                let mut e = self.value.clone();
+                e.elem_mul(d)?;
+                v.push(e);
             }
             sources.push(v);
         }

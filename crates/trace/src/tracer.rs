@@ -458,7 +458,7 @@ impl Tracer {
         // record, a ray descending from an ambient sample, or a specular/transmitted one
         let kind = if r.flags & SHADOW != 0 {
             1
-        } else if r.depth == 0 && r.flags == 0 {
+        } else if r.depth == 0 && r.flags & !IRRAD == 0 {
             0
         } else if r.flags & AMBIENT != 0 {
             2
