@@ -72,3 +72,20 @@ fn pcomb_nfiles_and_xform_zero_array() {
     assert!(out.stdout.is_empty());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// rtrace `-I`/`-i` with no value among the outputs fails, as Radiance's ("-I+ and -i+
+/// options require some value output").
+#[test]
+fn irradiance_without_a_value_output_is_an_error() {
+    let dir = common::scratch("geometry_rules_irr");
+    std::fs::write(dir.join("scene.rad"), SCENE).unwrap();
+    for opt in ["-i", "-I"] {
+        let mut c = common::fenestra("rtrace");
+        c.args(["-h", opt, "-oL", "scene.rad"]).current_dir(&dir);
+        let out = common::run_stdin(c, b"1 0 5 0 0 -1\n");
+        assert!(!out.status.success(), "{opt}");
+        assert!(String::from_utf8_lossy(&out.stderr).contains("require some value output"));
+        assert!(out.stdout.is_empty());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
