@@ -225,24 +225,30 @@ impl Tracer {
         let (a, b) = frame(nrm);
         let n = self.lobe_samples(r, scolor);
         let rod = s.rod.abs();
-        let mut taken: Vec<(DVec3, f64)> = Vec::with_capacity(n);
-        let mut trials = 0usize;
-        while taken.len() < n && trials < MAXITER * n {
-            trials += 1;
+        // one draw: the reflected direction and its W-G-M-D weight, or None below the surface
+        let draw = |cx: &mut Ctx| {
             let (tan, phi) = self.lobe_offset(alpha2, cx);
             let h = nrm + (a * phi.cos() + b * phi.sin()) * tan;
             let dir = d + h * (-2.0 * h.dot(d) / (1.0 + tan * tan));
             let dot = dir.dot(nrm);
-            if dot <= FTINY_SPEC {
-                continue;
-            }
-            taken.push((dir.normalize(), 2.0 / (1.0 + rod / dot)));
-        }
+            (dot > FTINY_SPEC).then(|| (dir.normalize(), 2.0 / (1.0 + rod / dot)))
+        };
         if n == 1 {
-            return match taken.first() {
-                Some(&(dir, _)) => self.spawn(r, s, dir, SPECULAR | REFLECTED, scolor, cx),
-                None => DVec3::ZERO,
-            };
+            // the usual case: the first direction above the surface, no list
+            for _ in 0..MAXITER {
+                if let Some((dir, _)) = draw(cx) {
+                    return self.spawn(r, s, dir, SPECULAR | REFLECTED, scolor, cx);
+                }
+            }
+            return DVec3::ZERO;
+        }
+        let mut taken: Vec<(DVec3, f64)> = Vec::with_capacity(n);
+        let mut trials = 0usize;
+        while taken.len() < n && trials < MAXITER * n {
+            trials += 1;
+            if let Some(t) = draw(cx) {
+                taken.push(t);
+            }
         }
         let weight = r.weight * maxc(scolor).min(1.0) / n as f64;
         let mut val = DVec3::ZERO;
