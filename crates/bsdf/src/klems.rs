@@ -39,11 +39,18 @@ pub struct KlemsBasis {
     len: usize,
     /// cos of each ring's upper polar bound (all rings but the last): the ring of a unit
     /// direction found from its z without an arc cosine.
-    cos_hi: Vec<f64>,
+    cos_hi: Box<[f64]>,
     /// Each ring's azimuthal patch boundaries as [`diamond`] angles, increasing, indexed from
     /// the ring's first patch: a patch found from a direction without an arc tangent.
-    dbound: Vec<f64>,
+    dbound: Box<[f64]>,
+    /// Per ring, [`CELLS`] entries: how many of the ring's boundaries lie at or below the
+    /// start of each equal cell of the diamond range [0, 4), so the patch takes a table read
+    /// and one comparison instead of a search; empty where a cell would hold two boundaries.
+    cell_start: Box<[u8]>,
 }
+
+/// Cells of the diamond range per ring in [`KlemsBasis::cell_start`].
+const CELLS: usize = 1024;
 
 /// Error building a basis from ring bounds.
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -107,11 +114,11 @@ impl KlemsBasis {
                 what: format!("last ring must end at 90 degrees, not {lo}"),
             });
         }
-        let cos_hi = out[..out.len() - 1]
+        let cos_hi: Vec<f64> = out[..out.len() - 1]
             .iter()
             .map(|r| r.theta_hi.to_radians().cos())
             .collect();
-        let dbound = out
+        let dbound: Vec<f64> = out
             .iter()
             .flat_map(|r| {
                 let inc = 360.0 / r.nphi as f64;
@@ -121,12 +128,14 @@ impl KlemsBasis {
                 })
             })
             .collect();
+        let cell_start = cell_table(&out, &dbound).into_boxed_slice();
         Ok(KlemsBasis {
             name: name.to_string(),
             rings: out,
             len: first,
-            cos_hi,
-            dbound,
+            cos_hi: cos_hi.into_boxed_slice(),
+            dbound: dbound.into_boxed_slice(),
+            cell_start,
         })
     }
 
@@ -227,12 +236,18 @@ impl KlemsBasis {
         // fast path: the ring from z against the bounds' cosines, unless z lies within
         // 1e-12 of one (or of the horizon), where the arc cosine decides as Radiance does
         const NEAR: f64 = 1e-12;
-        if u[2] > NEAR && self.cos_hi.iter().all(|c| (u[2] - c).abs() > NEAR) {
-            let r = self
-                .cos_hi
-                .iter()
-                .position(|&c| u[2] >= c)
-                .unwrap_or(self.rings.len() - 1);
+        let r = self
+            .cos_hi
+            .iter()
+            .position(|&c| u[2] >= c)
+            .unwrap_or(self.rings.len() - 1);
+        // the bounds nearest z are those either side of its ring
+        let near = |i: usize| {
+            self.cos_hi
+                .get(i)
+                .is_some_and(|&c| (u[2] - c).abs() <= NEAR)
+        };
+        if u[2] > NEAR && !near(r) && !(r > 0 && near(r - 1)) {
             if let Some(p) = self.in_ring_fast(r, u[0], u[1]) {
                 return Some(p);
             }
@@ -264,7 +279,14 @@ impl KlemsBasis {
         }
         let b = &self.dbound[ring.first..ring.first + ring.nphi];
         let d = diamond(x, y);
-        let k = b.partition_point(|&v| v <= d);
+        let k = if self.cell_start.is_empty() {
+            b.partition_point(|&v| v <= d)
+        } else {
+            // at most one boundary lies in d's cell: the count at the cell's start, plus it
+            let cell = ((d * (CELLS / 4) as f64) as usize).min(CELLS - 1);
+            let k0 = usize::from(self.cell_start[r * CELLS + cell]);
+            k0 + usize::from(b.get(k0).is_some_and(|&v| v <= d))
+        };
         let near = |i: usize| b.get(i).is_some_and(|&v| (d - v).abs() <= MARGIN);
         if near(k) || (k > 0 && near(k - 1)) {
             return None;
@@ -410,6 +432,30 @@ pub fn diamond(x: f64, y: f64) -> f64 {
     }
 }
 
+/// The per-ring cell table of [`KlemsBasis::cell_start`], or an empty one if a ring has
+/// more than 255 patches or two boundaries in one cell.
+fn cell_table(rings: &[Ring], dbound: &[f64]) -> Vec<u8> {
+    let mut table = Vec::with_capacity(rings.len() * CELLS);
+    for ring in rings {
+        let b = &dbound[ring.first..ring.first + ring.nphi];
+        if ring.nphi > 255 {
+            return Vec::new();
+        }
+        for cell in 0..CELLS {
+            let (lo, hi) = (
+                cell as f64 * 4.0 / CELLS as f64,
+                (cell + 1) as f64 * 4.0 / CELLS as f64,
+            );
+            let k0 = b.partition_point(|&v| v <= lo);
+            if b.partition_point(|&v| v < hi) > k0 + 1 {
+                return Vec::new();
+            }
+            table.push(k0 as u8);
+        }
+    }
+    table
+}
+
 /// Polar angle (degrees, from +z, clamped to [0,180]) and azimuth (degrees in [0,360), from +x
 /// towards +y) of a unit local direction, computed as Radiance's `klems_full.cal` does.
 pub fn local_angles(v: [f64; 3]) -> (f64, f64) {
@@ -512,10 +558,14 @@ mod tests {
             b.in_ring(r, a / (PI / 180.0))
         };
         let (mut checked, mut deferred) = (0usize, 0usize);
+        // a ring of 300 patches (no cell table: the search path) beside the three bases
+        let fine = KlemsBasis::from_bounds("fine", &[(10.0, 1), (50.0, 300), (90.0, 36)]).unwrap();
+        assert!(fine.cell_start.is_empty() && !KlemsBasis::full().cell_start.is_empty());
         for b in [
             KlemsBasis::full(),
             KlemsBasis::half(),
             KlemsBasis::quarter(),
+            &fine,
         ] {
             for r in 0..b.rings.len() {
                 let inc = 360.0 / b.rings[r].nphi as f64;

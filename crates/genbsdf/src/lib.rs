@@ -206,23 +206,28 @@ pub(crate) fn sides(opts: &Options) -> Vec<(bool, Direction, Direction)> {
     sides
 }
 
-/// A jittered point of cell `k` of the `nx` × `ny` sample grid over the box's `w` × `h`
-/// face from (x0, y0).
-pub(crate) fn plane_point(
-    rng: &mut fenestra_trace::rng::Rng,
+/// Where sample `k` of one incident direction starts and which way it heads within the
+/// direction's cell: (x, y) on the box's `w` × `h` face from (x0, y0), and two numbers in
+/// [0,1) for the direction (in that order: y, direction, direction, x), from a scrambled
+/// Sobol point.
+///
+/// The four are stratified jointly, not each pair on its own: whether a ray passes between
+/// two slats depends on where it starts across them and on its direction together, and a
+/// joint stratification estimates that fraction far better than independently stratified
+/// start points and directions paired at random. The scramble (`seed`, `key` = the
+/// incident direction) keeps every sample uniform, so the mean stays unbiased; `rng` (the
+/// sample's own stream) fills the digits below the 32nd.
+pub(crate) fn sample_start(
+    seed: u64,
+    key: u64,
     k: usize,
-    grid: (usize, usize),
-    x0: f64,
-    y0: f64,
-    w: f64,
-    h: f64,
-) -> (f64, f64) {
-    let (nx, ny) = grid;
-    let (ix, iy) = (k % nx, k / nx);
-    (
-        x0 + w * (ix as f64 + rng.next_f64()) / nx as f64,
-        y0 + h * (iy as f64 + rng.next_f64()) / ny as f64,
-    )
+    rng: &mut fenestra_trace::rng::Rng,
+    (x0, y0, w, h): (f64, f64, f64, f64),
+) -> (f64, f64, f64, f64) {
+    let mut keyed = fenestra_trace::rng::Rng::for_ray(seed ^ 0x736f_626f_6c34, key);
+    let seeds = [0; 4].map(|_: u64| keyed.next_u64());
+    let [y, u0, u1, x] = fenestra_trace::sobol::point4(k as u32, seeds, || rng.next_f64());
+    (x0 + w * x, y0 + h * y, u0, u1)
 }
 
 /// Adds one sample's squared total per slot to `sq` (for standard errors): the sample's
@@ -245,21 +250,6 @@ pub(crate) fn add_squares(hits: &mut [(usize, f64)], sq: &mut [f64]) {
 /// `-seed` (`-r '-seed N'`), so runs with different seeds are independent replicates.
 pub(crate) fn sample_seed(base: u64, opts: &Options) -> u64 {
     base ^ opts.trace.seed.wrapping_mul(0x9e37_79b9_7f4a_7c15)
-}
-
-/// The direction stratum of each of `n` samples of one incident direction (`key`): a
-/// random permutation of `0..n`, so sample k's position cell (k on the sample grid) and
-/// its direction stratum are paired at random. Both are stratified; pairing them in order
-/// would correlate where a ray starts with where it heads (a bias when the two interact,
-/// as across a blind's slats), pairing them at random leaves the pair uniform.
-pub(crate) fn direction_strata(seed: u64, key: u64, n: usize) -> Vec<u32> {
-    let mut perm: Vec<u32> = (0..n as u32).collect();
-    let mut rng = fenestra_trace::rng::Rng::for_ray(seed ^ 0x7065_726d_7574, key);
-    for j in (1..n).rev() {
-        let r = (rng.next_f64() * (j + 1) as f64) as usize;
-        perm.swap(j, r.min(j));
-    }
-    perm
 }
 
 /// What a run measured: the bounding box used and the BSDF.
@@ -370,15 +360,12 @@ pub fn characterise_with(
                     let mut sx = vec![0.0; if opts.colour { 2 * np } else { 0 }];
                     let mut sz = sx.clone();
                     let mut hits: Vec<(usize, f64)> = Vec::new();
-                    let strata = direction_strata(seed, (side_k * np + i) as u64, n);
-                    for (k, &stratum) in strata.iter().enumerate() {
+                    let key = (side_k * np + i) as u64;
+                    for k in 0..n {
                         hits.clear();
-                        let index = ((side_k * np + i) * n + k) as u64;
+                        let index = (key * n as u64) + k as u64;
                         let mut rng = fenestra_trace::rng::Rng::for_ray(seed, index);
-                        let (px, py) = plane_point(&mut rng, k, (nx, ny), x0, y0, w, h);
-                        // the direction within the patch, stratified (Hilbert order)
-                        let t = (f64::from(stratum) + rng.next_f64()) / n as f64;
-                        let (u0, u1) = fenestra_trace::rng::spread2(t, &mut rng);
+                        let (px, py, u0, u1) = sample_start(seed, key, k, &mut rng, (x0, y0, w, h));
                         let Some(b) = basis.sample_projected(i, u0, u1) else {
                             continue;
                         };

@@ -11,15 +11,14 @@ use anyhow::{bail, Result};
 use fenestra_bsdf::tree::{disk_to_square, square_to_disk, TensorTree};
 use fenestra_bsdf::{Block, BlockData, Bsdf, DataStructure, Wavelength};
 use fenestra_scene::Scene;
-use fenestra_trace::rng::{spread2, Rng};
+use fenestra_trace::rng::Rng;
 use fenestra_trace::DVec3;
 use rayon::prelude::*;
 
 use crate::reduce::{reciprocity, reduce, Grid};
 use crate::reduce_stream::{Rows, StreamReduce};
 use crate::{
-    add_squares, direction_strata, grid, plane_point, sample_seed, setup, sides, Characterised,
-    Options, Setup,
+    add_squares, grid, sample_seed, sample_start, setup, sides, Characterised, Options, Setup,
 };
 
 /// The grid cell of a unit direction of travel (its x and y on the disk).
@@ -188,14 +187,12 @@ pub fn characterise(
             let mut refl = vec![0.0; nch * ncell];
             let mut sq = vec![0.0; if opts.errors { 2 * ncell } else { 0 }];
             let mut hits: Vec<(usize, f64)> = Vec::new();
-            let strata = direction_strata(seed, (side_k * nin + cell) as u64, ns);
-            for (k, &stratum) in strata.iter().enumerate() {
+            let key = (side_k * nin + cell) as u64;
+            for k in 0..ns {
                 hits.clear();
-                let index = ((side_k * nin + cell) * ns + k) as u64;
+                let index = key * ns as u64 + k as u64;
                 let mut rng = Rng::for_ray(seed, index);
-                let (px, py) = plane_point(&mut rng, k, (nx, ny), x0, y0, w, h);
-                let t = (f64::from(stratum) + rng.next_f64()) / ns as f64;
-                let (s1, s2) = spread2(t, &mut rng);
+                let (px, py, s1, s2) = sample_start(seed, key, k, &mut rng, (x0, y0, w, h));
                 let (dx, dy) = if rank == 4 {
                     square_to_disk((ix as f64 + s1) / n as f64, (iy as f64 + s2) / n as f64)
                 } else {

@@ -22,6 +22,7 @@ pub mod pattern;
 pub mod polygon;
 pub mod rng;
 pub mod shape;
+pub mod sobol;
 pub mod surface;
 pub mod tracer;
 pub mod waves;
