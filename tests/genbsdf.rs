@@ -273,12 +273,15 @@ fn three_phase_with_our_blind_matches_radiance_file() {
 /// with `-n 1` as with `-n 2`).
 /// Checked as z-scores of our `-c 100` file against Radiance's genBSDF file (`-c 1000`,
 /// 1023 samples per direction against our 110, so its own noise adds about 10% to the
-/// variance; z uses ours only, scaled by √1.1). Reflection is smooth: z should be about
-/// N(0, 1) — measured mean z² 1.15 and 1.05, 99.2% and 99.3% within 3 — limits 0.7–1.6
-/// and 98%. Transmission has rare straight-through paths at grazing incidence that 110
-/// samples can miss entirely (the sample's spread is then 0 or tiny, mean z² 46 and 23):
-/// measured 98.2% within |z| < 3 and a median |z| of 0.66 and 0.67 (N(0, 1): 0.674);
-/// limits 97% and 0.45–0.9.
+/// variance; z uses ours only, scaled by √1.1). The spread over √N is exact for independent
+/// samples and an upper bound for the jointly stratified (Sobol) ones drawn: on this blind
+/// 1.41× (reflection) and 1.59× (transmission) the replicate spread at `-c 100`, so z comes
+/// out narrower than N(0, 1). Reflection is smooth: measured mean z² 0.90 and 0.88 (1.15 and
+/// 1.05 with the former, independently stratified sampler), 99.4% and 99.6% within 3 —
+/// limits 0.7–1.6 and 98% (an `-E` too small or grossly too large fails). Transmission has
+/// rare straight-through paths at grazing incidence that 110 samples can miss entirely (the
+/// sample's spread is then 0 or tiny, mean z² 18 and 75): measured 98.9% and 98.6% within
+/// |z| < 3 and a median |z| of 0.59 and 0.62 (N(0, 1): 0.674); limits 97% and 0.45–0.9.
 #[test]
 fn standard_errors_explain_the_difference_from_radiance() {
     let dir = scratch("genbsdf-errors");
