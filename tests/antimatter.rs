@@ -48,14 +48,14 @@ fn walls(wall_mat: &str) -> String {
 /// plate embedded in the wall behind recess e, blue background), so the values must be equal.
 #[test]
 fn oracle_holes_and_recesses_are_seen_as_radiance_sees_them() {
-    let Some(o) = common::oracle() else { return };
-    let dir = common::scratch("antimatter");
     let mut s = walls("void glow wall 0 0 4 1 0 0 0\n");
     s += "void glow blue 0 0 4 0 0 1 0\n";
     s += "blue polygon bg 0 0 12  -10 5 -10  10 5 -10  10 5 10  -10 5 10\n";
     s += "void glow green 0 0 4 0 1 0 0\n";
     s += "green polygon emb 0 0 12  .5 .7 1  1.5 .7 1  1.5 .7 1.8  .5 .7 1.8\n";
-    std::fs::write(dir.join("scene.rad"), s).unwrap();
+    let Some((o, dir)) = common::probe::oracle_scene("antimatter", &s) else {
+        return;
+    };
     let rays = [
         "-1 -3 0 0 1 0",         // through the hole: background
         "-1 -3 0 0 1 0.1",       // through the hole, slanted
@@ -83,45 +83,37 @@ fn oracle_holes_and_recesses_are_seen_as_radiance_sees_them() {
 /// colours give the 2e-5 relative tolerance.
 #[test]
 fn oracle_recess_bottom_is_lit_through_the_antimatter() {
-    let Some(o) = common::oracle() else { return };
-    let dir = common::scratch("antimatter_lit");
     let mut s = walls("void plastic wall 0 0 5 .5 .4 .3 0 0\n");
     s += "void light sun 0 0 3 1e4 1e4 1e4\nsun source s 0 0 4 .1 -1 .3 .5\n";
-    std::fs::write(dir.join("scene.rad"), s).unwrap();
+    let Some((o, dir)) = common::probe::oracle_scene("antimatter_lit", &s) else {
+        return;
+    };
     let rays = "1 -3 0 0 1 0\n0 -3 0 0 1 0\n1 -3 0.2 0.1 1 0\n-1 -3 0 0 1 0\n1 -3 1.4 0 1 0\n";
     for outs in [["-ov"], ["-oN"]] {
         let mut opts = vec!["-h", "-ab", "0", "-dj", "0"];
         opts.extend(outs);
         let (t, f) = common::both_rtrace(&o, &dir, &opts, rays);
         assert!(t.iter().any(|v| *v != 0.0));
-        for (k, (a, b)) in t.iter().zip(&f).enumerate() {
-            assert!(
-                (a - b).abs() <= 2e-5 * a.abs().max(1e-3),
-                "{outs:?} value {k}: oracle {a} ours {b}"
-            );
-        }
+        common::probe::agree_6_digits(&t, &f, |k| format!("{outs:?} value {k}: "));
     }
 }
 
 /// An antimatter naming an undefined modifier: a warning naming it, as Radiance's.
 #[test]
 fn unknown_antimatter_modifier_is_a_warning() {
-    let dir = common::scratch("antimatter_unknown");
     let s = "void glow red 0 0 4 1 0 0 0\nred polygon p 0 0 12 -1 1 -1 1 1 -1 1 1 1 -1 1 1\n\
              void antimatter hole 2 red nosuch 0 0\n"
         .to_string()
         + &boxed("hole", "a", [-0.5, 0.5, -0.5], [1.0, 1.0, 1.0]);
-    std::fs::write(dir.join("scene.rad"), s).unwrap();
-    let mut c = common::fenestra("rtrace");
-    c.args(["-h", "-ov", "scene.rad"]).current_dir(&dir);
-    let out = common::run_stdin(c, b"0 0 0 0 1 0\n");
-    assert!(out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        err.contains("nosuch") && err.contains("scene.rad:3"),
-        "{err}"
+    let v = common::probe::rtrace_file(
+        "antimatter_unknown",
+        "scene.rad",
+        &s,
+        &["-h", "-ov"],
+        b"0 0 0 0 1 0\n",
+        &["nosuch", "scene.rad:3"],
     );
     // The ray passes the plate's front while blind to `red`, so it leaves the antimatter
     // "inside" red, and the exit face is shaded red (the reference rtrace gives 1 0 0 too).
-    assert_eq!(common::numbers(&out.stdout), vec![1.0, 0.0, 0.0]);
+    assert_eq!(v, vec![1.0, 0.0, 0.0]);
 }

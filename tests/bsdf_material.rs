@@ -77,6 +77,18 @@ skyglow source sky\n0\n0\n4 0 0 -1 180\n\
 void BSDF win\n6 0 FILE 0 1 0 .\n0\n0\n\
 win polygon pane\n0\n0\n12 -1 -1 0 1 -1 0 1 1 0 -1 1 0\n";
 
+/// A grey ceiling above the window, facing down.
+const CEILING: &str = "void plastic grey\n0\n0\n5 .5 .5 .5 0 0\n\
+grey polygon ceiling\n0\n0\n12 -5 -5 3 -5 5 3 5 5 3 5 -5 3\n";
+
+/// Writes the Klems file `name` of `b` into `dir` and, as `file`, [`SCENE`] with the window's
+/// material text `from` replaced by `to`, the file named and [`CEILING`] added.
+fn write_ceiling_scene(dir: &Path, file: &str, (from, to): (&str, &str), (name, b): (&str, &Bsdf)) {
+    std::fs::write(dir.join(name), klems_xml(b, None).unwrap()).unwrap();
+    let scene = SCENE.replace(from, to).replace("FILE", name) + CEILING;
+    std::fs::write(dir.join(file), scene).unwrap();
+}
+
 /// View rays from the +z side through the window's centre: along the sun (inside its
 /// patch), 6° beside it, and along the normal.
 fn views(copies: usize) -> String {
@@ -113,9 +125,7 @@ fn trace(
     std::fs::write(dir.join("scene.rad"), SCENE.replace("FILE", file)).unwrap();
     let out = match oracle {
         Some(o) => {
-            let mut c = o.command("oconv");
-            c.arg("scene.rad").current_dir(dir);
-            std::fs::write(dir.join("scene.oct"), common::run_ok(&mut c)).unwrap();
+            common::oracle_octree(o, dir, &["scene.rad"]);
             let mut c = o.command("rtrace");
             c.args(["-h", "-aa", "0"])
                 .args(opts)
@@ -130,11 +140,7 @@ fn trace(
             run_stdin(c, rays.as_bytes())
         }
     };
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_ok(&out);
     numbers(&out.stdout)
         .chunks(3)
         .map(|c| 0.265 * c[0] + 0.670 * c[1] + 0.065 * c[2])
@@ -239,13 +245,7 @@ fn bsdf_hard_cases_stay_finite() {
                 .arg("hard.rad")
                 .current_dir(&dir);
             c.env("RAYPATH", &dir);
-            let out = run_stdin(c, rays.as_bytes());
-            assert!(
-                out.status.success(),
-                "{}",
-                String::from_utf8_lossy(&out.stderr)
-            );
-            let v = numbers(&out.stdout);
+            let v = numbers(&common::pipe_ok(c, rays.as_bytes()));
             assert_eq!(v.len(), 3 * 11);
             assert!(
                 v.iter().all(|x| x.is_finite() && *x >= 0.0),
@@ -263,28 +263,14 @@ fn oracle_bsdf_proxy_passes_view_and_shadow_rays() {
     let Some(o) = common::oracle() else { return };
     let dir = scratch("bsdf-material-proxy");
     let (name, b) = files().remove(3);
-    std::fs::write(dir.join(name), klems_xml(&b, None).unwrap()).unwrap();
     // a floor above the window, facing down: lit by the sun through the proxy
-    let scene = SCENE.replace("6 0 FILE", "6 0.01 FILE").replace("FILE", name)
-        + "void plastic grey\n0\n0\n5 .5 .5 .5 0 0\ngrey polygon ceiling\n0\n0\n12 -5 -5 3 -5 5 3 5 5 3 5 -5 3\n";
-    std::fs::write(dir.join("proxy.rad"), &scene).unwrap();
-    let mut c = o.command("oconv");
-    c.arg("proxy.rad").current_dir(&dir);
-    std::fs::write(dir.join("proxy.oct"), common::run_ok(&mut c)).unwrap();
+    let window = ("6 0 FILE", "6 0.01 FILE");
+    write_ceiling_scene(&dir, "proxy.rad", window, (name, &b));
     let mut rays = views(1);
     // the sky seen from below the window, and the ceiling seen from between (lit by the
     // sun through the proxy at one point, shadowed by nothing else)
     rays.push_str("0 1 -2 0 0 -1\n0.3 -0.2 -2.5 0 0 -1\n0 -1.5 1 0 0 1\n2 2 1 0 0 1\n");
-    let mut c = o.command("rtrace");
-    c.args(["-h", "-aa", "0", "-ab", "0", "-ss", "0", "proxy.oct"])
-        .current_dir(&dir);
-    let theirs = numbers(&run_stdin(c, rays.as_bytes()).stdout);
-    let mut c = fenestra("rtrace");
-    c.args(["-h", "-ab", "0", "-ss", "0", "proxy.rad"])
-        .current_dir(&dir);
-    c.env("RAYPATH", &dir);
-    let ours = numbers(&run_stdin(c, rays.as_bytes()).stdout);
-    assert_eq!(theirs.len(), ours.len());
+    let (theirs, ours) = common::direct_both(&o, &dir, &["proxy.rad"], &rays);
     assert!(
         theirs.iter().filter(|v| **v > 0.0).count() >= 9,
         "{theirs:?}"
@@ -306,34 +292,13 @@ fn oracle_absdf_through_component() {
         if name == "uniform.xml" {
             continue; // no peak
         }
-        std::fs::write(dir.join(name), klems_xml(&b, None).unwrap()).unwrap();
-        let scene = SCENE
-            .replace("void BSDF win\n6 0 FILE", "void aBSDF win\n5 FILE")
-            .replace("FILE", name)
-            + "void plastic grey\n0\n0\n5 .5 .5 .5 0 0\ngrey polygon ceiling\n0\n0\n12 -5 -5 3 -5 5 3 5 5 3 5 -5 3\n";
-        std::fs::write(dir.join("ab.rad"), &scene).unwrap();
-        let mut c = o.command("oconv");
-        c.arg("ab.rad").current_dir(&dir);
-        std::fs::write(dir.join("ab.oct"), common::run_ok(&mut c)).unwrap();
+        let window = ("void BSDF win\n6 0 FILE", "void aBSDF win\n5 FILE");
+        write_ceiling_scene(&dir, "ab.rad", window, (name, &b));
         let mut rays = views(1);
         rays.push_str("0 -1.5 1 0 0 1\n2 2 1 0 0 1\n0.2 0.1 0.5 0.1 0.2 -1\n");
-        let mut c = o.command("rtrace");
-        c.args(["-h", "-aa", "0", "-ab", "0", "-ss", "0", "ab.oct"])
-            .current_dir(&dir);
-        let theirs = numbers(&run_stdin(c, rays.as_bytes()).stdout);
-        let mut c = fenestra("rtrace");
-        c.args(["-h", "-ab", "0", "-ss", "0", "ab.rad"])
-            .current_dir(&dir);
-        c.env("RAYPATH", &dir);
-        let ours = numbers(&run_stdin(c, rays.as_bytes()).stdout);
-        assert_eq!(theirs.len(), ours.len());
-        for (k, (a, b)) in theirs.iter().zip(&ours).enumerate() {
-            assert!(
-                (a - b).abs() <= 2e-3 * a.abs() + 1e-9,
-                "{name} value {k}: oracle {a} ours {b}"
-            );
-            lit += usize::from(*a > 0.0);
-        }
+        let (theirs, ours) = common::direct_both(&o, &dir, &["ab.rad"], &rays);
+        common::agree(name, &theirs, &ours, 2e-3, 1e-9);
+        lit += theirs.iter().filter(|a| **a > 0.0).count();
     }
     assert!(lit >= 30, "{lit} lit values");
 }

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{fenestra, fixture, numbers, run_stdin, scratch};
+use common::{fenestra, fixture, numbers, scratch};
 use std::path::{Path, PathBuf};
 
 /// A scratch copy of the reference office with the window's BSDF file replaced by `tree`
@@ -41,6 +41,15 @@ fn office(name: &str, tree: &str) -> PathBuf {
     dir
 }
 
+/// The office lit by the sun alone: its scene files.
+const SUN_SCENE: [&str; 5] = [
+    "materials.rad",
+    "room.rad",
+    "exterior.rad",
+    "window.rad",
+    "sun.rad",
+];
+
 /// Mean luminance over the sensors (in the order given).
 fn mean(out: &[u8]) -> f64 {
     let v = numbers(out);
@@ -55,9 +64,7 @@ fn mean(out: &[u8]) -> f64 {
 /// variation at `-as 0`) and ours over as many seeds.
 fn both(dir: &Path, scene: &[&str], opts: &[&str], orders: u64) -> (Vec<f64>, Vec<f64>) {
     let o = common::oracle().expect("oracle");
-    let mut c = o.command("oconv");
-    c.args(scene).current_dir(dir);
-    std::fs::write(dir.join("scene.oct"), common::run_ok(&mut c)).unwrap();
+    common::oracle_octree(&o, dir, scene);
     let text = std::fs::read_to_string(dir.join("sensors.pts")).unwrap();
     let lines: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
     let (mut theirs, mut ours) = (Vec::new(), Vec::new());
@@ -75,26 +82,14 @@ fn both(dir: &Path, scene: &[&str], opts: &[&str], orders: u64) -> (Vec<f64>, Ve
             .args(opts)
             .arg("scene.oct")
             .current_dir(dir);
-        let out = run_stdin(c, input.as_bytes());
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        theirs.push(mean(&out.stdout));
+        theirs.push(mean(&common::pipe_ok(c, input.as_bytes())));
         let mut c = fenestra("rtrace");
         c.args(["-h", "-I+", "-seed", &k.to_string()])
             .args(opts)
             .args(scene)
             .current_dir(dir);
         c.env("RAYPATH", dir);
-        let out = run_stdin(c, text.as_bytes());
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        ours.push(mean(&out.stdout));
+        ours.push(mean(&common::pipe_ok(c, text.as_bytes())));
     }
     (theirs, ours)
 }
@@ -149,14 +144,7 @@ fn oracle_tree_windows_agree_within_noise() {
         let opts = ["-ab", "1", "-ad", "2048", "-lw", "1e-4"];
         let (t, o) = both(&dir, &sky, &opts, 32);
         agree(&format!("{tree} overcast -ab 1"), &t, &o);
-        let sun = [
-            "materials.rad",
-            "room.rad",
-            "exterior.rad",
-            "window.rad",
-            "sun.rad",
-        ];
-        let (t, o) = both(&dir, &sun, &opts, 32);
+        let (t, o) = both(&dir, &SUN_SCENE, &opts, 32);
         let (ta, ts) = common::mean_sem(&t);
         let (oa, os) = common::mean_sem(&o);
         let se = (ts * ts + os * os).sqrt();
@@ -183,28 +171,7 @@ fn direct_views(o: &common::Oracle, dir: &Path) -> (Vec<f64>, Vec<f64>) {
             rays.push_str(&format!("2 1.0 1.65 {:.6} {:.6} {:.6}\n", d[0], d[1], d[2]));
         }
     }
-    let scene = [
-        "materials.rad",
-        "room.rad",
-        "exterior.rad",
-        "window.rad",
-        "sun.rad",
-    ];
-    let mut c = o.command("oconv");
-    c.args(scene).current_dir(dir);
-    std::fs::write(dir.join("scene.oct"), common::run_ok(&mut c)).unwrap();
-    let mut c = o.command("rtrace");
-    c.args(["-h", "-aa", "0", "-ab", "0", "-ss", "0", "scene.oct"])
-        .current_dir(dir);
-    let theirs = numbers(&run_stdin(c, rays.as_bytes()).stdout);
-    let mut c = fenestra("rtrace");
-    c.args(["-h", "-ab", "0", "-ss", "0"])
-        .args(scene)
-        .current_dir(dir);
-    c.env("RAYPATH", dir);
-    let ours = numbers(&run_stdin(c, rays.as_bytes()).stdout);
-    assert_eq!(theirs.len(), ours.len());
-    (theirs, ours)
+    common::direct_both(o, dir, &SUN_SCENE, &rays)
 }
 
 /// Without jitter and ambient light the direct sun through a tree is deterministic in both
@@ -287,10 +254,11 @@ fn oracle_west_room_low_sun_ab5() {
         dir.join("blinds_kf.xml"),
     )
     .unwrap();
-    std::fs::write(dir.join("room.rad"), ROOM_WEST).unwrap();
+    let room = room_west();
+    std::fs::write(dir.join("room.rad"), &room).unwrap();
     std::fs::write(
         dir.join("low.rad"),
-        ROOM_WEST.replace(
+        room.replace(
             "-12 -20 0 -12 25 0 -12 25 8 -12 -20 8",
             "-12 -20 0 -12 25 0 -12 25 1 -12 -20 1",
         ),
@@ -324,70 +292,65 @@ fn oracle_west_room_low_sun_ab5() {
     }
 }
 
-const ROOM_WEST: &str = "void plastic wall\n\
-0\n\
-0\n\
-5 .6 .6 .6 0 0\n\
-void plastic floorm\n\
-0\n\
-0\n\
-5 .3 .3 .3 0 0\n\
-void plastic bldg\n\
-0\n\
-0\n\
-5 .35 .3 .25 0 0\n\
-void plastic ground\n\
-0\n\
-0\n\
-5 .2 .2 .2 0 0\n\
-# room x 0..4 (west wall at x=0), y 0..5, z 0..3\n\
-floorm polygon floor\n\
-0\n\
-0\n\
-12 0 0 0 4 0 0 4 5 0 0 5 0\n\
-wall polygon ceiling\n\
-0\n\
-0\n\
-12 0 0 3 0 5 3 4 5 3 4 0 3\n\
-wall polygon east\n\
-0\n\
-0\n\
-12 4 0 0 4 0 3 4 5 3 4 5 0\n\
-wall polygon south\n\
-0\n\
-0\n\
-12 0 0 0 0 0 3 4 0 3 4 0 0\n\
-wall polygon north\n\
-0\n\
-0\n\
-12 0 5 0 4 5 0 4 5 3 0 5 3\n\
-# west wall with a window hole 0.5..4.5 (y) x 0.8..2.6 (z)\n\
-wall polygon west_low\n\
-0\n\
-0\n\
-12 0 0 0 0 5 0 0 5 0.8 0 0 0.8\n\
-wall polygon west_high\n\
-0\n\
-0\n\
-12 0 0 2.6 0 5 2.6 0 5 3 0 0 3\n\
-wall polygon west_s\n\
-0\n\
-0\n\
-12 0 0 0.8 0 0.5 0.8 0 0.5 2.6 0 0 2.6\n\
-wall polygon west_n\n\
-0\n\
-0\n\
-12 0 4.5 0.8 0 5 0.8 0 5 2.6 0 4.5 2.6\n\
-# building opposite: a facade 12 m west, 8 m high, and the ground\n\
-bldg polygon facade\n\
-0\n\
-0\n\
-12 -12 -20 0 -12 25 0 -12 25 8 -12 -20 8\n\
-ground polygon grnd\n\
-0\n\
-0\n\
-12 -40 -40 -0.01 40 -40 -0.01 40 40 -0.01 -40 40 -0.01\n\
-";
+/// A polygon of a scene: (material, name, vertices).
+type Polygon = (&'static str, &'static str, &'static str);
+
+/// The west room (x 0..4, y 0..5, z 0..3, a window hole in its west wall) and the building
+/// opposite: its polygons, in groups under a comment line.
+const ROOM_WEST_POLYGONS: [(&str, &[Polygon]); 3] = [
+    (
+        "# room x 0..4 (west wall at x=0), y 0..5, z 0..3",
+        &[
+            ("floorm", "floor", "0 0 0 4 0 0 4 5 0 0 5 0"),
+            ("wall", "ceiling", "0 0 3 0 5 3 4 5 3 4 0 3"),
+            ("wall", "east", "4 0 0 4 0 3 4 5 3 4 5 0"),
+            ("wall", "south", "0 0 0 0 0 3 4 0 3 4 0 0"),
+            ("wall", "north", "0 5 0 4 5 0 4 5 3 0 5 3"),
+        ],
+    ),
+    (
+        "# west wall with a window hole 0.5..4.5 (y) x 0.8..2.6 (z)",
+        &[
+            ("wall", "west_low", "0 0 0 0 5 0 0 5 0.8 0 0 0.8"),
+            ("wall", "west_high", "0 0 2.6 0 5 2.6 0 5 3 0 0 3"),
+            ("wall", "west_s", "0 0 0.8 0 0.5 0.8 0 0.5 2.6 0 0 2.6"),
+            ("wall", "west_n", "0 4.5 0.8 0 5 0.8 0 5 2.6 0 4.5 2.6"),
+        ],
+    ),
+    (
+        "# building opposite: a facade 12 m west, 8 m high, and the ground",
+        &[
+            ("bldg", "facade", "-12 -20 0 -12 25 0 -12 25 8 -12 -20 8"),
+            (
+                "ground",
+                "grnd",
+                "-40 -40 -0.01 40 -40 -0.01 40 40 -0.01 -40 40 -0.01",
+            ),
+        ],
+    ),
+];
+
+/// The west room's scene: its plastic materials, then [`ROOM_WEST_POLYGONS`].
+fn room_west() -> String {
+    let mut s = String::new();
+    for (name, rgb) in [
+        ("wall", ".6 .6 .6"),
+        ("floorm", ".3 .3 .3"),
+        ("bldg", ".35 .3 .25"),
+        ("ground", ".2 .2 .2"),
+    ] {
+        s.push_str(&format!("void plastic {name}\n0\n0\n5 {rgb} 0 0\n"));
+    }
+    for (comment, polygons) in ROOM_WEST_POLYGONS {
+        s.push_str(comment);
+        s.push('\n');
+        for (material, name, vertices) in polygons {
+            s.push_str(&format!("{material} polygon {name}\n0\n0\n12 {vertices}\n"));
+        }
+    }
+    s
+}
+
 const WINDOW_WEST: &str =
     "# the blind, its up vector turned 30 degrees: an asymmetric device for this room\n\
 void BSDF blind\n\
@@ -469,19 +432,14 @@ fn tree_with_tiny_leaves_stays_finite() {
                 .arg("tiny.rad")
                 .current_dir(&dir);
             c.env("RAYPATH", &dir);
-            let out = run_stdin(c, rays.as_bytes());
-            assert!(
-                out.status.success(),
-                "{}",
-                String::from_utf8_lossy(&out.stderr)
-            );
-            let v = numbers(&out.stdout);
+            let stdout = common::pipe_ok(c, rays.as_bytes());
+            let v = numbers(&stdout);
             assert_eq!(v.len(), 3 * 120);
             assert!(v.iter().all(|x| x.is_finite() && *x >= 0.0), "{opts:?}");
             assert!(v.iter().any(|x| *x > 0.0));
             match &first {
-                None => first = Some(out.stdout),
-                Some(f) => assert!(*f == out.stdout, "{opts:?}: -n 1 and -n 2 differ"),
+                None => first = Some(stdout),
+                Some(f) => assert!(*f == stdout, "{opts:?}: -n 1 and -n 2 differ"),
             }
         }
     }

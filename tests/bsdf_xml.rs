@@ -173,8 +173,9 @@ fn reduced(keep: impl Fn(&str) -> bool, dir: &Path, name: &str) -> std::path::Pa
 
 #[test]
 fn oracle_transmission_back_only_uses_reciprocity() {
-    let Some(o) = common::oracle() else { return };
-    let dir = common::scratch("bsdf-tf-only");
+    let Some((o, dir)) = common::cli::oracle_scratch("bsdf-tf-only") else {
+        return;
+    };
     let xml = reduced(
         |b| b.contains(">Visible<") && b.contains("Transmission Back"),
         &dir,
@@ -217,8 +218,9 @@ fn synthetic(
 
 #[test]
 fn oracle_mixed_bases_and_specular_peak() {
-    let Some(o) = common::oracle() else { return };
-    let dir = common::scratch("bsdf-synthetic");
+    let Some((o, dir)) = common::cli::oracle_scratch("bsdf-synthetic") else {
+        return;
+    };
     let (full, half, quarter) = (
         KlemsBasis::full(),
         KlemsBasis::half(),
@@ -403,8 +405,9 @@ fn worst_matrix_difference(
 /// chromaticity one 1/410 step off would differ by 1e-3 or more.
 #[test]
 fn oracle_colour_dither_reproduced() {
-    let Some(o) = common::oracle() else { return };
-    let dir = common::scratch("bsdf-colour");
+    let Some((o, dir)) = common::cli::oracle_scratch("bsdf-colour") else {
+        return;
+    };
     let p = coloured_xml(&dir, false);
     let b = read_file(&p).unwrap();
     let t = transmission_matrix(&b).unwrap();
@@ -434,8 +437,9 @@ fn oracle_colour_dither_reproduced() {
 /// before the recipe was known, moves a channel by 1e-3 or more).
 #[test]
 fn oracle_colour_with_lambertian_part() {
-    let Some(o) = common::oracle() else { return };
-    let dir = common::scratch("bsdf-colour-split");
+    let Some((o, dir)) = common::cli::oracle_scratch("bsdf-colour-split") else {
+        return;
+    };
     let p = coloured_xml(&dir, true);
     let t = transmission_matrix(&read_file(&p).unwrap()).unwrap();
     let theirs = oracle_matrix(&o, &p);
@@ -487,8 +491,9 @@ fn oracle_colour_with_lambertian_part() {
 /// that element) and no negative value.
 #[test]
 fn oracle_negative_colour_remainder_is_zero() {
-    let Some(o) = common::oracle() else { return };
-    let dir = common::scratch("bsdf-colour-negative");
+    let Some((o, dir)) = common::cli::oracle_scratch("bsdf-colour-negative") else {
+        return;
+    };
     let full = KlemsBasis::full();
     let n = full.len();
     let dip = largest_position_factor(n);
@@ -544,8 +549,9 @@ fn oracle_negative_colour_remainder_is_zero() {
 /// by reciprocity (it was the 145x145 Lambertian matrix).
 #[test]
 fn oracle_grey_lambertian_split() {
-    let Some(o) = common::oracle() else { return };
-    let dir = common::scratch("bsdf-grey-split");
+    let Some((o, dir)) = common::cli::oracle_scratch("bsdf-grey-split") else {
+        return;
+    };
     let full = KlemsBasis::full();
     let n = full.len();
     let dip = largest_position_factor(n);
@@ -637,8 +643,9 @@ fn constant_colour_xml(dir: &Path, name: &str, xyz: [f64; 3]) -> std::path::Path
 /// and single-precision steps, as `oracle_colour_with_lambertian_part`; measured 1.6e-7 to 3.0e-7).
 #[test]
 fn oracle_constant_colours() {
-    let Some(o) = common::oracle() else { return };
-    let dir = common::scratch("bsdf-constant-colours");
+    let Some((o, dir)) = common::cli::oracle_scratch("bsdf-constant-colours") else {
+        return;
+    };
     for (k, xyz) in [
         [2.9, 3.0, 3.3],
         [0.3, 0.25, 0.1],
@@ -669,8 +676,9 @@ fn oracle_constant_colours() {
 /// ours: within 1.5e-7; asserted 1e-6 (float32 output and single-precision steps, as above).
 #[test]
 fn oracle_out_of_gamut_constant_colours() {
-    let Some(o) = common::oracle() else { return };
-    let dir = common::scratch("bsdf-out-of-gamut");
+    let Some((o, dir)) = common::cli::oracle_scratch("bsdf-out-of-gamut") else {
+        return;
+    };
     let cases = [
         ([0.1, 0.2, 0.3], false),
         ([0.1, 0.2, 0.3], true),

@@ -9,8 +9,6 @@
 
 mod common;
 
-use std::process::Command;
-
 /// Tubes in several orientations, lengths and radii, near and far, each with its own
 /// material, and two blockers (sources sharing a material: tests/source_objects.rs).
 const SCENE: &str = "
@@ -56,11 +54,9 @@ const PRINTED: f64 = 3e-6;
 
 #[test]
 fn oracle_tubes_with_no_jitter_equal_radiance() {
-    let Some(oracle) = common::oracle() else {
+    let Some((oracle, dir)) = common::probe::oracle_scene("cyl_dj0", SCENE) else {
         return;
     };
-    let dir = common::scratch("cyl_dj0");
-    std::fs::write(dir.join("scene.rad"), SCENE).unwrap();
     let rays = rays();
     for extra in [
         &["-ds", "0"][..],
@@ -75,70 +71,46 @@ fn oracle_tubes_with_no_jitter_equal_radiance() {
         let (t, o) = common::both_rtrace(&oracle, &dir, &opts, &rays);
         let lit = t.iter().filter(|v| **v > 0.0).count();
         assert!(lit > 80, "{extra:?}: only {lit} lit values");
-        let worst = common::agree(&format!("{extra:?}"), &t, &o, PRINTED, 1e-12);
-        eprintln!("{extra:?}: largest relative difference {worst:.3e}");
+        common::probe::agree_noted(&format!("{extra:?}"), &t, &o, PRINTED, 1e-12);
     }
 }
 
 #[test]
 fn oracle_tube_seen_directly() {
-    let Some(oracle) = common::oracle() else {
+    let Some((oracle, dir)) = common::probe::oracle_scene("cyl_direct", SCENE) else {
         return;
     };
-    let dir = common::scratch("cyl_direct");
-    std::fs::write(dir.join("scene.rad"), SCENE).unwrap();
     // rays from below and the side onto t1, t2 and t3, and one passing t1's end
     let rays = "0.7 0 1 0 0 1\n-0.8 -1 2 0 1 0\n0.5 1 1 0 0 1\n4 2 1.5 0 1 0\n1.2 0 1 0 0 1\n";
     let (t, o) = common::both_rtrace(&oracle, &dir, &["-h", "-ab", "0", "-ov"], rays);
     assert_eq!(&t[0..3], &[10.0, 10.0, 10.0]);
-    for (k, (a, b)) in t.iter().zip(&o).enumerate() {
-        assert!(
-            (a - b).abs() <= PRINTED * a.abs() + 1e-12,
-            "value {k}: oracle {a} ours {b}"
-        );
-    }
+    common::agree("direct", &t, &o, PRINTED, 1e-12);
 }
 
 #[test]
 fn oracle_rcontrib_tube_contributions() {
-    let Some(oracle) = common::oracle() else {
+    let Some((oracle, dir)) = common::probe::oracle_scene("cyl_rcontrib", SCENE) else {
         return;
     };
-    let dir = common::scratch("cyl_rcontrib");
-    std::fs::write(dir.join("scene.rad"), SCENE).unwrap();
-    let mut c = oracle.command("oconv");
-    c.arg("scene.rad").current_dir(&dir);
-    std::fs::write(dir.join("scene.oct"), common::run_ok(&mut c)).unwrap();
     let rays = rays();
     // rcontrib's -dj default is .9: -dj 0 for a deterministic comparison (it forces -dt 0)
     for extra in [&["-ds", "0"][..], &[], &["-ds", ".05"]] {
         let mut args = vec!["-h", "-ab", "0", "-dj", "0"];
         args.extend_from_slice(extra);
         args.extend_from_slice(&["-m", "m1", "-m", "m2", "-m", "m5"]);
-        let mut theirs = oracle.command("rcontrib");
-        theirs.args(&args).arg("scene.oct").current_dir(&dir);
-        let t = common::run_stdin(theirs, rays.as_bytes());
-        assert!(t.status.success(), "{}", String::from_utf8_lossy(&t.stderr));
-        let mut ours = common::fenestra("rcontrib");
-        ours.args(&args).arg("scene.rad").current_dir(&dir);
-        let o = common::run_stdin(ours, rays.as_bytes());
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let (t, o) = (common::numbers(&t.stdout), common::numbers(&o.stdout));
+        let (t, o) = common::probe::both(&oracle, &dir, "rcontrib", &args, &rays);
         assert_eq!(t.len(), 32 * 9);
         assert_eq!(t.len(), o.len());
         assert!(t.iter().filter(|v| **v > 0.0).count() > 150);
-        let worst = common::agree(&format!("{extra:?}"), &t, &o, PRINTED, 1e-12);
-        eprintln!("{extra:?}: largest relative difference {worst:.3e}");
+        common::probe::agree_noted(&format!("{extra:?}"), &t, &o, PRINTED, 1e-12);
     }
 }
 
 #[test]
 fn oracle_jittered_tubes_agree_within_monte_carlo_error() {
-    let Some(oracle) = common::oracle() else {
+    let Some((oracle, dir)) = common::probe::oracle_scene("cyl_dj", SCENE) else {
         return;
     };
-    let dir = common::scratch("cyl_dj");
-    std::fs::write(dir.join("scene.rad"), SCENE).unwrap();
     // each point repeated: both draw new jitter for every record
     let reps = 1500;
     let points = [
@@ -157,26 +129,15 @@ fn oracle_jittered_tubes_agree_within_monte_carlo_error() {
         let (t, o) = common::both_rtrace(&oracle, &dir, &opts, &rays);
         for (k, p) in points.iter().enumerate() {
             // red channel of each record
-            let pick = |v: &[f64]| -> Vec<f64> {
-                v[k * reps * 3..(k + 1) * reps * 3]
-                    .iter()
-                    .step_by(3)
-                    .copied()
-                    .collect()
-            };
-            let ((mt, st), (mo, so)) = (common::mean_sem(&pick(&t)), common::mean_sem(&pick(&o)));
+            let [(mt, st), (mo, so)] = common::probe::red_means(&t, &o, k, reps);
             // 5 combined standard errors (4 would fail about once in 2500 runs over the
             // 9 checks: the oracle's clock-seeded means vary by 0.84 to 1.06 s.e.).
             // Measured at the first floor point: spread per record 39% of the mean with
             // -ds 0, 5.6% with the default -ds .2, 0.5% with -ds .05; over the 9 checks
             // the two spreads agree within 0.95 to 1.13 and the means within 1.3
             // combined standard errors.
-            let tol = 5.0 * (st * st + so * so).sqrt();
-            assert!(
-                (mt - mo).abs() <= tol,
-                "{extra:?} point {}: oracle {mt} ± {st}, ours {mo} ± {so}",
-                p.trim()
-            );
+            let what = format!("{extra:?} point {}", p.trim());
+            common::probe::means_agree(&what, [(mt, st), (mo, so)]);
             assert!(st > 0.0 && so > 0.0 && so < 1.5 * st && st < 1.5 * so);
         }
     }
@@ -208,58 +169,36 @@ fn light_on_a_cone_cup_or_tube_is_an_error() {
 #[test]
 fn glow_without_radius_on_a_cone_is_no_source() {
     // as in Radiance: a glow of radius 0 is no light source, so any surface may carry it
-    let dir = common::scratch("cyl_glow0");
     let scene = "void glow g 0 0 4 1 1 1 0\ng cone c 0 0 8 0 0 2 1 0 2 .1 .05\n";
-    std::fs::write(dir.join("ok.rad"), scene).unwrap();
-    let mut c: Command = common::fenestra("rtrace");
-    c.args(["-h", "-ab", "0", "ok.rad"]).current_dir(&dir);
-    let out = common::run_stdin(c, b"0.5 0 1 0 0 1\n");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let ray = b"0.5 0 1 0 0 1\n";
+    let v = common::probe::rtrace_file("cyl_glow0", "ok.rad", scene, &["-h", "-ab", "0"], ray, &[]);
     // the view ray meets the cone (radius .075 there): its glow colour
-    assert_eq!(common::numbers(&out.stdout), vec![1.0, 1.0, 1.0]);
+    assert_eq!(v, vec![1.0, 1.0, 1.0]);
 }
 
 #[test]
 fn fat_cylinder_source_warns_like_radiance() {
     // Radiance: "source aspect too small" for a radius above 0.2 x length
-    let dir = common::scratch("cyl_fat");
     let scene = "void light l 0 0 3 1 1 1\nl cylinder fat 0 0 7 0 0 2 1 0 2 .3\n";
-    std::fs::write(dir.join("fat.rad"), scene).unwrap();
-    let mut c: Command = common::fenestra("rtrace");
-    c.args(["-h", "-ab", "0", "fat.rad"]).current_dir(&dir);
-    let out = common::run_stdin(c, b"0.5 0 0 0 0 1\n");
-    assert!(out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        err.contains("fat.rad:2") && err.contains("aspect too small"),
-        "{err}"
+    let v = common::probe::rtrace_file(
+        "cyl_fat",
+        "fat.rad",
+        scene,
+        &["-h", "-ab", "0"],
+        b"0.5 0 0 0 0 1\n",
+        &["fat.rad:2", "aspect too small"],
     );
-    assert_eq!(common::numbers(&out.stdout), vec![1.0, 1.0, 1.0]);
+    assert_eq!(v, vec![1.0, 1.0, 1.0]);
 }
 
 #[test]
 fn jittered_tubes_do_not_depend_on_threads() {
-    let dir = common::scratch("cyl_threads");
-    std::fs::write(dir.join("scene.rad"), SCENE).unwrap();
+    let dir = common::probe::scene_dir("cyl_threads", SCENE);
     // 96 records: past the 32 traced in order, into the parallel blocks
     let rays = rays().repeat(3);
     let run = |n: &str, opts: &[&str]| {
-        let mut c: Command = common::fenestra("rtrace");
-        c.args(["-h", "-ab", "0", "-n", n])
-            .args(opts)
-            .arg("scene.rad")
-            .current_dir(&dir);
-        let out = common::run_stdin(c, rays.as_bytes());
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        out.stdout
+        let args = [&["-h", "-ab", "0", "-n", n][..], opts].concat();
+        common::probe::ours("rtrace", &dir, &args, "scene.rad", rays.as_bytes()).stdout
     };
     for opts in [
         &["-dj", ".7"][..],

@@ -16,6 +16,13 @@ fn run(dir: &Path, args: &[&str]) -> std::process::Output {
     c.output().unwrap()
 }
 
+/// [`run`], asserting success (the failure message is the tool's stderr).
+fn run_ok(dir: &Path, args: &[&str]) -> std::process::Output {
+    let out = run(dir, args);
+    common::assert_ok(&out);
+    out
+}
+
 /// A .wea of `hours` (month 1, day 1.., local hours given) with zero irradiance.
 fn wea(hours: &[f64]) -> String {
     let mut s = String::from(
@@ -51,14 +58,9 @@ fn metrics_by_hand_with_occupancy_and_bands() {
     };
     write(&dir, "a.err", &e(0.06));
     write(&dir, "b.err", &e(0.08));
-    let out = run(
+    let out = run_ok(
         &dir,
         &["-w", "t.wea", "-E", "a.err", "-E", "b.err", "ill.dat"],
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
     let text = String::from_utf8_lossy(&out.stdout);
     let rows: Vec<Vec<&str>> = text
@@ -93,14 +95,9 @@ fn metrics_by_hand_with_occupancy_and_bands() {
     assert!(room.ends_with("over 2 sensors, 3 occupied hours"), "{room}");
     // the floor-plan map: a cell per sensor and panel, values printed
     write(&dir, "p.pts", "0.5 0.5 0.8 0 0 1\n1.5 0.5 0.8 0 0 1\n");
-    let out = run(
+    run_ok(
         &dir,
         &["-w", "t.wea", "-p", "p.pts", "-m", "map.svg", "ill.dat"],
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
     let svg = std::fs::read_to_string(dir.join("map.svg")).unwrap();
     assert_eq!(svg.matches("stroke=\"white\"").count(), 4, "{svg}");

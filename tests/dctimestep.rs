@@ -753,11 +753,7 @@ fn picture_form_errors() {
         .arg(&sky)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_ok(&out);
     let p = fenestra_formats::picture::Picture::read(&mut &out.stdout[..], "t").unwrap();
     let want = [3.0f32, 12.0, 27.0];
     for px in &p.pixels {
@@ -769,15 +765,10 @@ fn picture_form_errors() {
         ("b%03d.hdr", ["b001.hdr", "5 x 3", "b000.hdr"]),
         ("c%03d.hdr", ["c000.hdr", "picture", "FORMAT"]),
     ] {
-        let out = common::fenestra("dctimestep")
-            .current_dir(&dir)
-            .arg(pattern)
-            .arg(&sky)
-            .output()
-            .unwrap();
-        assert!(!out.status.success(), "{pattern}");
-        assert!(out.stdout.is_empty(), "{pattern}: output written");
-        let err = String::from_utf8_lossy(&out.stderr);
+        let mut c = common::fenestra("dctimestep");
+        c.current_dir(&dir).arg(pattern).arg(&sky);
+        let (stdout, err) = common::output_err(&mut c, pattern);
+        assert!(stdout.is_empty(), "{pattern}: output written");
         for w in words {
             assert!(err.contains(w), "{pattern}: '{err}' lacks '{w}'");
         }

@@ -217,13 +217,13 @@ fn error_files_have_the_result_s_shape_and_bad_shapes_are_refused() {
     assert_eq!(r.len(), e.len());
     assert!(e.iter().all(|v| *v > 0.0 && v.is_finite()));
     let head = std::fs::read_to_string(dir.join("res.err")).unwrap();
-    assert!(
-        head.contains("CONTENTS= Monte Carlo standard error"),
-        "{head}"
-    );
-    assert!(
-        head.contains("NROWS=45") && head.contains("NCOLS=1"),
-        "{head}"
+    common::cli::assert_contains(
+        &head,
+        &[
+            "CONTENTS= Monte Carlo standard error",
+            "NROWS=45",
+            "NCOLS=1",
+        ],
     );
     // an error file of another shape than its matrix: refused, naming what differs
     let t = std::fs::read_to_string(dir.join("res.err")).unwrap();
@@ -279,12 +279,7 @@ fn v_command(dir: &Path, extra: &[&str]) -> std::process::Output {
 #[test]
 fn replica_files_hold_k_rows_per_record_whose_mean_is_the_value() {
     let dir = common::scratch("dc-replica-files");
-    let out = v_command(&dir, &["-E", "-Er", "4", "-o", "V.vmx"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_ok(&v_command(&dir, &["-E", "-Er", "4", "-o", "V.vmx"]));
     let head = std::fs::read_to_string(dir.join("V.vmx.rep")).unwrap();
     assert!(head.contains("NREPLICAS=4\n") && head.contains("CONTENTS= 4 independent replica"));
     let body = |f: &str| {
@@ -321,12 +316,7 @@ fn replica_files_hold_k_rows_per_record_whose_mean_is_the_value() {
         (&["-E", "-Er", "1", "-o", "d.vmx"], "from 2 to 4096"),
         (&["-E", "-Er", "4"], "-Eo"),
     ] {
-        let out = v_command(&dir, extra);
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert!(
-            !out.status.success() && err.contains(want),
-            "{extra:?}: {err}"
-        );
+        common::cli::assert_refused(&v_command(&dir, extra), want, extra);
     }
     // dctimestep: replicas and standard errors of the same matrix; a file without NREPLICAS
     let sky = fx("threephase/sky_t4_sep21_1200_overcast.skv");
@@ -342,12 +332,7 @@ fn replica_files_hold_k_rows_per_record_whose_mean_is_the_value() {
             .args(["-Eo", "x.err"].iter().filter(|_| want != "-Eo"))
             .args(["V.vmx", &xml, &d, &sky])
             .current_dir(&dir);
-        let out = dc.output().unwrap();
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert!(
-            !out.status.success() && err.contains(want),
-            "{args:?}: {err}"
-        );
+        common::cli::assert_refused(&dc.output().unwrap(), want, args);
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -359,12 +344,7 @@ fn rmtxop_carries_replicas_as_dctimestep_does() {
     // (rmtxop holds values in single precision: 1e-4 relative) and the same result
     let dir = common::scratch("rmtxop-errors");
     let b = common::fixture("rtrace_threephase_bsdf");
-    let out = v_command(&dir, &["-E", "-Er", "4", "-o", "V.vmx"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_ok(&v_command(&dir, &["-E", "-Er", "4", "-o", "V.vmx"]));
     // D: 8 rays per Klems patch in 4 groups
     let mut g = common::fenestra("genklemsamp");
     g.args([

@@ -4,12 +4,37 @@
 
 mod common;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 const FIXTURE: &str = "direct_threshold";
 
+/// The text of `file` in the fixture folder.
+fn fixture_text(file: &str) -> String {
+    std::fs::read_to_string(common::fixture(FIXTURE).join(file)).unwrap()
+}
+
 fn points() -> String {
-    std::fs::read_to_string(common::fixture(FIXTURE).join("points.txt")).unwrap()
+    fixture_text("points.txt")
+}
+
+/// The oracle and a fresh scratch folder `name` holding the fixture's scene as `edit`
+/// returns it; `None`, with nothing read or written, where the oracle is missing.
+fn oracle_fixture(
+    name: &str,
+    edit: impl FnOnce(String) -> String,
+) -> Option<(common::Oracle, PathBuf)> {
+    let oracle = common::oracle()?;
+    let scene = edit(fixture_text("scene.rad"));
+    Some((oracle, common::probe::scene_dir(name, &scene)))
+}
+
+/// The record `x y z 0 0 1` of the point of `line` (`x y z`) moved by 1.3 cm × `k` along x.
+fn shifted(line: &str, k: u32) -> String {
+    let v: Vec<f64> = line
+        .split_whitespace()
+        .map(|w| w.parse().unwrap())
+        .collect();
+    format!("{} {} {} 0 0 1\n", v[0] + 0.013 * k as f64, v[1], v[2])
 }
 
 /// The first value (red) of every record.
@@ -86,15 +111,9 @@ fn agree(oracle: &common::Oracle, dir: &Path, rays: &str, min_effect: f64) {
 
 #[test]
 fn oracle_thresholding_with_the_obstructor_cache() {
-    let Some(oracle) = common::oracle() else {
+    let Some((oracle, dir)) = oracle_fixture("dt_cache", |scene| scene) else {
         return;
     };
-    let dir = common::scratch("dt_cache");
-    std::fs::copy(
-        common::fixture(FIXTURE).join("scene.rad"),
-        dir.join("scene.rad"),
-    )
-    .unwrap();
     agree(&oracle, &dir, &points(), 0.01);
     // the statistics follow the order of the records: reversed input, same agreement
     let rev: String = points().lines().rev().map(|l| format!("{l}\n")).collect();
@@ -115,15 +134,13 @@ fn oracle_thresholding_with_the_obstructor_cache() {
 fn oracle_thresholding_without_the_obstructor_cache() {
     // `trans` walls of zero transmission stop shadow rays but are not an opaque type:
     // neither tool caches them, so this checks the ordering, threshold and hit statistics
-    let Some(oracle) = common::oracle() else {
+    let Some((oracle, dir)) = oracle_fixture("dt_nocache", |scene| {
+        let plastic = "void plastic wall_m 0 0 5 .5 .5 .5 0 0";
+        assert!(scene.contains(plastic));
+        scene.replace(plastic, "void trans wall_m 0 0 7 .5 .5 .5 0 0 0 0")
+    }) else {
         return;
     };
-    let dir = common::scratch("dt_nocache");
-    let scene = std::fs::read_to_string(common::fixture(FIXTURE).join("scene.rad")).unwrap();
-    let plastic = "void plastic wall_m 0 0 5 .5 .5 .5 0 0";
-    assert!(scene.contains(plastic));
-    let scene = scene.replace(plastic, "void trans wall_m 0 0 7 .5 .5 .5 0 0 0 0");
-    std::fs::write(dir.join("scene.rad"), scene).unwrap();
     agree(&oracle, &dir, &points(), 0.005);
 }
 
@@ -131,27 +148,21 @@ fn oracle_thresholding_without_the_obstructor_cache() {
 fn oracle_thresholding_with_a_sun_among_the_lamps() {
     // a distant source (its own obstructor-cache layout) ranked among the lamps: its
     // direct irradiance on the points is of the order of the brightest lamps'
-    let Some(oracle) = common::oracle() else {
+    let Some((oracle, dir)) = oracle_fixture("dt_sun_lamps", |mut scene| {
+        scene.push_str(
+            "void light solar 0 0 3 3e3 3e3 3e3\nsolar source sun 0 0 4 0.45 0.3 0.84 0.533\n",
+        );
+        scene
+    }) else {
         return;
     };
-    let dir = common::scratch("dt_sun_lamps");
-    let mut scene = std::fs::read_to_string(common::fixture(FIXTURE).join("scene.rad")).unwrap();
-    scene.push_str(
-        "void light solar 0 0 3 3e3 3e3 3e3\nsolar source sun 0 0 4 0.45 0.3 0.84 0.533\n",
-    );
-    std::fs::write(dir.join("scene.rad"), scene).unwrap();
     agree(&oracle, &dir, &points(), 0.01);
 }
 
+/// Runs our rtrace on `scene.rad` in `dir` with `opts` over `rays`, asserting success;
+/// returns its (stdout, stderr).
 fn run(dir: &Path, opts: &[&str], rays: &str) -> (Vec<u8>, String) {
-    let mut c = common::fenestra("rtrace");
-    c.args(opts).arg("scene.rad").current_dir(dir);
-    let out = common::run_stdin(c, rays.as_bytes());
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = common::probe::ours("rtrace", dir, opts, "scene.rad", rays.as_bytes());
     (
         out.stdout,
         String::from_utf8_lossy(&out.stderr).into_owned(),
@@ -165,13 +176,7 @@ fn thresholded_output_is_the_same_for_any_thread_count() {
     let mut rays = String::new();
     for k in 0..10 {
         for l in points().lines() {
-            let v: Vec<f64> = l.split_whitespace().map(|w| w.parse().unwrap()).collect();
-            rays.push_str(&format!(
-                "{} {} {} 0 0 1\n",
-                v[0] + 0.013 * k as f64,
-                v[1],
-                v[2]
-            ));
+            rays.push_str(&shifted(l, k));
         }
     }
     // radiance of the floor and walls seen looking down
@@ -296,25 +301,13 @@ fn oracle_thresholding_with_an_ambient_bounce() {
     // above that mean difference, against an effect of 0.033. (Radiance's
     // own -n 2 moves this ratio by 0.002 to 0.0075 on these scenes: each process keeps its
     // own statistics.)
-    let Some(oracle) = common::oracle() else {
+    let Some((oracle, dir)) = oracle_fixture("dt_ab1", |scene| scene) else {
         return;
     };
-    let dir = common::scratch("dt_ab1");
-    std::fs::copy(
-        common::fixture(FIXTURE).join("scene.rad"),
-        dir.join("scene.rad"),
-    )
-    .unwrap();
     let mut rays = String::new();
     for l in points().lines() {
-        let v: Vec<f64> = l.split_whitespace().map(|w| w.parse().unwrap()).collect();
         for k in 0..4 {
-            rays.push_str(&format!(
-                "{} {} {} 0 0 1\n",
-                v[0] + 0.013 * k as f64,
-                v[1],
-                v[2]
-            ));
+            rays.push_str(&shifted(l, k));
         }
     }
     let opts = "-ab 1 -ad 256 -aa 0";

@@ -45,12 +45,7 @@ fn errplot_draws_a_chart_and_refuses_bad_tables() {
         std::fs::write(dir.join("t.tsv"), table).unwrap();
         let mut c = common::fenestra("errplot");
         c.args(args).arg("t.tsv").current_dir(&dir);
-        let out = c.output().unwrap();
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert!(
-            !out.status.success() && err.contains(want),
-            "{table:?}: {err}"
-        );
+        common::cli::assert_refused(&c.output().unwrap(), want, table);
     }
     let _ = std::fs::remove_dir_all(&dir);
 }

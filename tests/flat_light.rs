@@ -10,7 +10,7 @@
 
 mod common;
 
-use std::process::Command;
+use std::path::PathBuf;
 
 /// A wall (x = .5, y from -3 to .3, z up to 1.5) partly between the lamps and the points,
 /// and a floor below the lowest point.
@@ -90,23 +90,28 @@ fn scene(lamp: &str) -> String {
     format!("{lamp}\n{ROOM}")
 }
 
+/// Each of [`LAMPS`] by name, with the scratch folder `dir_name` made afresh to hold its
+/// scene as the loop reaches it.
+fn lamp_dirs(dir_name: &str) -> impl Iterator<Item = (&'static str, PathBuf)> + '_ {
+    LAMPS
+        .into_iter()
+        .map(move |(name, lamp)| (name, common::probe::scene_dir(dir_name, &scene(lamp))))
+}
+
 #[test]
 fn oracle_flat_sources_with_no_jitter_equal_radiance() {
     let Some(oracle) = common::oracle() else {
         return;
     };
     let pts = points();
-    for (name, lamp) in LAMPS {
-        let dir = common::scratch("flat_dj0");
-        std::fs::write(dir.join("scene.rad"), scene(lamp)).unwrap();
+    for (name, dir) in lamp_dirs("flat_dj0") {
         for extra in [&["-ds", "0"][..], &[], &["-ds", ".05"], &["-ds", ".5"]] {
             let mut opts = vec!["-h", "-I", "-ab", "0", "-u-", "-dj", "0", "-dt", "0"];
             opts.extend_from_slice(extra);
             let (t, o) = common::both_rtrace(&oracle, &dir, &opts, &pts);
             let lit = t.iter().filter(|v| **v > 0.0).count();
             assert!(lit > 150, "{name} {extra:?}: only {lit} lit values");
-            let worst = common::agree(&format!("{name} {extra:?}"), &t, &o, PRINTED, 1e-12);
-            eprintln!("{name} {extra:?}: largest relative difference {worst:.3e}");
+            common::probe::agree_noted(&format!("{name} {extra:?}"), &t, &o, PRINTED, 1e-12);
         }
     }
 }
@@ -148,8 +153,7 @@ fn oracle_turned_and_tilted_squares_and_hexagons_equal_radiance() {
     // measured: 231 to 333 of the 378 values lit, all within 1.0e-6 (9.86e-7 the largest,
     // the first hexagon at the default -ds and at .05)
     for (k, lamp) in lamps.iter().enumerate() {
-        let dir = common::scratch("flat_turned");
-        std::fs::write(dir.join("scene.rad"), scene(lamp)).unwrap();
+        let dir = common::probe::scene_dir("flat_turned", &scene(lamp));
         for extra in [&[][..], &["-ds", ".5"], &["-ds", ".05"]] {
             let mut opts = vec!["-h", "-I", "-ab", "0", "-u-", "-dj", "0", "-dt", "0"];
             opts.extend_from_slice(extra);
@@ -177,15 +181,12 @@ fn oracle_thresholded_flat_sources_equal_radiance_over_32_records() {
         .take(32)
         .map(|l| format!("{l}\n"))
         .collect();
-    for (name, lamp) in LAMPS {
-        let dir = common::scratch("flat_dt");
-        std::fs::write(dir.join("scene.rad"), scene(lamp)).unwrap();
+    for (name, dir) in lamp_dirs("flat_dt") {
         for extra in [&[][..], &["-ds", ".05", "-dt", ".2"]] {
             let mut opts = vec!["-h", "-I", "-ab", "0", "-u-", "-dj", "0"];
             opts.extend_from_slice(extra);
             let (t, o) = common::both_rtrace(&oracle, &dir, &opts, &pts);
-            let worst = common::agree(&format!("{name} {extra:?}"), &t, &o, PRINTED, 1e-12);
-            eprintln!("{name} {extra:?}: largest relative difference {worst:.3e}");
+            common::probe::agree_noted(&format!("{name} {extra:?}"), &t, &o, PRINTED, 1e-12);
         }
     }
 }
@@ -195,37 +196,17 @@ fn oracle_rcontrib_flat_contributions() {
     let Some(oracle) = common::oracle() else {
         return;
     };
-    let pts = points();
-    for (name, lamp) in LAMPS {
-        let dir = common::scratch("flat_rcontrib");
-        std::fs::write(dir.join("scene.rad"), scene(lamp)).unwrap();
-        let mut c = oracle.command("oconv");
-        c.arg("scene.rad").current_dir(&dir);
-        std::fs::write(dir.join("scene.oct"), common::run_ok(&mut c)).unwrap();
+    for (name, dir) in lamp_dirs("flat_rcontrib") {
         // rcontrib's -dj default is .9 and -u+: -dj 0 -u- for a deterministic comparison
         for extra in [&["-ds", "0"][..], &[], &["-ds", ".05"]] {
             let mut args = vec!["-h", "-I", "-ab", "0", "-u-", "-dj", "0"];
             args.extend_from_slice(extra);
             args.extend_from_slice(&["-m", "L"]);
-            let mut theirs = oracle.command("rcontrib");
-            theirs.args(&args).arg("scene.oct").current_dir(&dir);
-            let t = common::run_stdin(theirs, pts.as_bytes());
-            assert!(t.status.success(), "{}", String::from_utf8_lossy(&t.stderr));
-            let mut ours = common::fenestra("rcontrib");
-            ours.args(&args).arg("scene.rad").current_dir(&dir);
-            let o = common::run_stdin(ours, pts.as_bytes());
-            assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-            let (t, o) = (common::numbers(&t.stdout), common::numbers(&o.stdout));
+            let (t, o) = common::probe::both(&oracle, &dir, "rcontrib", &args, &points());
             assert_eq!(t.len(), 126 * 3);
             assert!(t.iter().filter(|v| **v > 0.0).count() > 150);
-            let worst = common::agree(
-                &format!("rcontrib {name} {extra:?}"),
-                &t,
-                &o,
-                PRINTED,
-                1e-12,
-            );
-            eprintln!("rcontrib {name} {extra:?}: largest relative difference {worst:.3e}");
+            let what = format!("rcontrib {name} {extra:?}");
+            common::probe::agree_noted(&what, &t, &o, PRINTED, 1e-12);
         }
     }
 }
@@ -258,8 +239,7 @@ fn oracle_jittered_flat_sources_agree_within_monte_carlo_error() {
         (LAMPS[6].0, LAMPS[6].1, "-u-"),
         (LAMPS[4].0, LAMPS[4].1, "-u-"),
     ] {
-        let dir = common::scratch("flat_dj");
-        std::fs::write(dir.join("scene.rad"), scene(lamp)).unwrap();
+        let dir = common::probe::scene_dir("flat_dj", &scene(lamp));
         // -dj .9 maps a disk's single sample onto the disk too (above .7)
         for extra in [
             &["-ds", "0", "-dj", ".7"][..],
@@ -272,30 +252,18 @@ fn oracle_jittered_flat_sources_agree_within_monte_carlo_error() {
             opts.extend_from_slice(extra);
             let (t, o) = common::both_rtrace(&oracle, &dir, &opts, &rays);
             for (k, p) in points.iter().enumerate() {
-                let pick = |v: &[f64]| -> Vec<f64> {
-                    v[k * reps * 3..(k + 1) * reps * 3]
-                        .iter()
-                        .step_by(3)
-                        .copied()
-                        .collect()
-                };
-                let ((mt, st), (mo, so)) =
-                    (common::mean_sem(&pick(&t)), common::mean_sem(&pick(&o)));
-                // 5 combined standard errors. The oracle's 1000-record means vary between
-                // its clock-seeded runs by 1.02 to 1.20 of their standard errors (skewed
-                // values; 60 runs a second apart): at 4 s.e. the 24 checks would fail
-                // about once in 300 runs, at 5 about once in 20000.
-                let tol = 5.0 * (st * st + so * so).sqrt();
+                let [(mt, st), (mo, so)] = common::probe::red_means(&t, &o, k, reps);
                 eprintln!(
                     "{name} {extra:?} point {}: oracle {mt:.6} ± {st:.2e}, ours {mo:.6} ± {so:.2e}, {:.2} s.e.",
                     p.trim(),
                     (mt - mo).abs() / (st * st + so * so).sqrt().max(1e-300)
                 );
-                assert!(
-                    (mt - mo).abs() <= tol,
-                    "{name} {extra:?} point {}: oracle {mt} ± {st}, ours {mo} ± {so}",
-                    p.trim()
-                );
+                // 5 combined standard errors. The oracle's 1000-record means vary between
+                // its clock-seeded runs by 1.02 to 1.20 of their standard errors (skewed
+                // values; 60 runs a second apart): at 4 s.e. the 24 checks would fail
+                // about once in 300 runs, at 5 about once in 20000.
+                let what = format!("{name} {extra:?} point {}", p.trim());
+                common::probe::means_agree(&what, [(mt, st), (mo, so)]);
                 // spreads per record within a factor 2: with 1000 skewed records a
                 // spread is known less well than its normal-theory 2-3%; the oracle's own
                 // spread at the square's first point with -ds 0 -dj .9 varied by 9.7%
@@ -314,22 +282,10 @@ fn oracle_jittered_flat_sources_agree_within_monte_carlo_error() {
 #[test]
 fn jittered_flat_sources_do_not_depend_on_threads() {
     let pts = points();
-    for (name, lamp) in LAMPS {
-        let dir = common::scratch("flat_threads");
-        std::fs::write(dir.join("scene.rad"), scene(lamp)).unwrap();
+    for (name, dir) in lamp_dirs("flat_threads") {
         let run = |n: &str, opts: &[&str]| {
-            let mut c: Command = common::fenestra("rtrace");
-            c.args(["-h", "-I", "-ab", "0", "-n", n])
-                .args(opts)
-                .arg("scene.rad")
-                .current_dir(&dir);
-            let out = common::run_stdin(c, pts.as_bytes());
-            assert!(
-                out.status.success(),
-                "{}",
-                String::from_utf8_lossy(&out.stderr)
-            );
-            out.stdout
+            let args = [&["-h", "-I", "-ab", "0", "-n", n][..], opts].concat();
+            common::probe::ours("rtrace", &dir, &args, "scene.rad", pts.as_bytes()).stdout
         };
         for opts in [
             &["-dj", ".7"][..],
@@ -356,30 +312,29 @@ fn flat_sources_radiance_cannot_aim_at_are_errors() {
         &["bad.rad:2", "polygon 'p'", "cannot hit source center"],
     );
     // a ring with an inner radius is fine as an ordinary surface
-    let dir = common::scratch("flat_ring_ok");
     let scene = "void plastic p 0 0 5 .5 .5 .5 0 0\np ring r 0 0 8 0 0 2 0 0 -1 .2 .5\n";
-    std::fs::write(dir.join("ok.rad"), scene).unwrap();
-    let mut c: Command = common::fenestra("rtrace");
-    c.args(["-h", "-ab", "0", "ok.rad"]).current_dir(&dir);
-    assert!(common::run_stdin(c, b"0 .3 0 0 0 1\n").status.success());
+    common::probe::rtrace_file(
+        "flat_ring_ok",
+        "ok.rad",
+        scene,
+        &["-h", "-ab", "0"],
+        b"0 .3 0 0 0 1\n",
+        &[],
+    );
 }
 
 #[test]
 fn thin_triangle_source_warns_like_radiance() {
     // Radiance: "triangular source with poor aspect" when the centre is within
     // sqrt(.08 x area) of an edge
-    let dir = common::scratch("flat_thin");
     let scene = "void light l 0 0 3 1 1 1\nl polygon thin 0 0 9 0 0 2 0 1 2 .05 .5 2\n";
-    std::fs::write(dir.join("thin.rad"), scene).unwrap();
-    let mut c: Command = common::fenestra("rtrace");
-    c.args(["-h", "-I", "-ab", "0", "thin.rad"])
-        .current_dir(&dir);
-    let out = common::run_stdin(c, b"0 0 0 0 0 1\n");
-    assert!(out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        err.contains("thin.rad:2") && err.contains("poor aspect"),
-        "{err}"
+    let v = common::probe::rtrace_file(
+        "flat_thin",
+        "thin.rad",
+        scene,
+        &["-h", "-I", "-ab", "0"],
+        b"0 0 0 0 0 1\n",
+        &["thin.rad:2", "poor aspect"],
     );
-    assert!(common::numbers(&out.stdout)[0] > 0.0);
+    assert!(v[0] > 0.0);
 }

@@ -532,19 +532,23 @@ fn tame_mgf(text: &str) -> String {
 
 /// `.cal` definitions (`Program::load_str`, then `Program::compile`).
 fn check_cal(input: &[u8]) -> Result<(), String> {
-    let text = String::from_utf8_lossy(input);
-    let mut prog = Program::for_renderer();
-    if prog.load_str("fuzz.cal", &text).is_ok() {
-        let _ = prog.compile();
-    }
-    Ok(())
+    check_program(input, |prog, text| prog.load_str("fuzz.cal", text))
 }
 
 /// A standalone `.cal` expression (`Program::add_expr`, then `Program::compile`).
 fn check_expr(input: &[u8]) -> Result<(), String> {
-    let text = String::from_utf8_lossy(input);
+    check_program(input, |prog, text| prog.add_expr("fuzz", text))
+}
+
+/// The input as text given to a renderer's program by `load`, then `Program::compile` when
+/// it loaded.
+fn check_program<T, E>(
+    input: &[u8],
+    load: impl FnOnce(&mut Program, &str) -> Result<T, E>,
+) -> Result<(), String> {
+    let text: &str = &String::from_utf8_lossy(input);
     let mut prog = Program::for_renderer();
-    if prog.add_expr("fuzz", &text).is_ok() {
+    if load(&mut prog, text).is_ok() {
         let _ = prog.compile();
     }
     Ok(())

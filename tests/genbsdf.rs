@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{fenestra, fixture, run_ok, run_stdin, scratch};
+use common::{fenestra, fixture, output_ok, run_ok, run_stdin, scratch};
 use fenestra_bsdf::{read_file, Bsdf, Direction, KlemsBasis, Wavelength};
 
 /// The four Klems blocks genBSDF writes with `+f +b`.
@@ -873,12 +873,7 @@ fn resumes_as_uninterrupted(name: &str, args: &[&str], lines: usize) {
         .args(args)
         .arg(&mgf)
         .current_dir(&dir);
-    let out = c.output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = output_ok(&mut c);
     assert!(String::from_utf8_lossy(&out.stderr).contains("resuming from 'ck.txt'"));
     let strip = |t: &str| -> String {
         t.lines()

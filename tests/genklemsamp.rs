@@ -42,16 +42,6 @@ fn rows(text: &[u8]) -> Vec<Vec<f64>> {
         .collect()
 }
 
-fn pipe(cmd: Command, input: &[u8]) -> Vec<u8> {
-    let out = common::run_stdin(cmd, input);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out.stdout
-}
-
 #[test]
 fn counts_and_formats() {
     let a = window_rays(3, "-fa");
@@ -147,7 +137,7 @@ fn theta_uniform_within_rings() {
 }
 
 fn kbin_column(rcalc: Command, rays: &[u8]) -> Vec<i64> {
-    let out = pipe(rcalc, rays);
+    let out = common::pipe_ok(rcalc, rays);
     String::from_utf8_lossy(&out)
         .lines()
         .map(|l| l.trim().parse().unwrap())
@@ -320,7 +310,7 @@ fn oracle_d_matrix_from_our_rays() {
         "skyglow",
         "dmx.oct",
     ]);
-    let ours = red_rows(&pipe(rc, &rays));
+    let ours = red_rows(&common::pipe_ok(rc, &rays));
     let reference = red_rows(&std::fs::read(common::fixture("threephase/D.dmx")).unwrap());
     assert_eq!(ours.len(), 145);
     assert_eq!(reference.len(), 145);
@@ -385,7 +375,7 @@ fn d_matrix_with_rtcontrib() {
         "skyglow",
         "dmx.oct",
     ]);
-    let ours = red_rows(&pipe(rc, &rays));
+    let ours = red_rows(&common::pipe_ok(rc, &rays));
     let reference = red_rows(&std::fs::read(common::fixture("threephase/D.dmx")).unwrap());
     assert_eq!(ours.len(), 145);
     let (mut ta, mut tb, mut worst) = (0.0, 0.0, 0.0f64);
@@ -439,11 +429,7 @@ fn window_group_area_weighted() {
         ])
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_ok(&out);
     assert!(String::from_utf8_lossy(&out.stderr).contains("tilted"));
     let r = rows(&out.stdout);
     assert_eq!(r.len(), 14500);

@@ -109,16 +109,10 @@ fn dimensions_of_a_matrix() {
 /// Missing files and data without a header: a message naming the file, exit status 1.
 #[test]
 fn bad_input_is_reported() {
-    let dir = common::scratch("getinfo-bad");
-    std::fs::write(dir.join("noheader.txt"), "1 2 3\n4 5 6\n").unwrap();
-    for args in [
-        &["missing.hdr"][..],
-        &["noheader.txt"],
-        &["-d", "noheader.txt"],
-    ] {
-        let out = run(common::fenestra("getinfo"), &dir, args, None);
-        assert!(!out.status.success(), "getinfo {args:?} succeeded");
-        let err = String::from_utf8_lossy(&out.stderr);
+    let dir = common::cli::scratch_files("getinfo-bad", &[("noheader.txt", "1 2 3\n4 5 6\n")]);
+    let cases: [&[&str]; 3] = [&["missing.hdr"], &["noheader.txt"], &["-d", "noheader.txt"]];
+    let outs = common::cli::failures("getinfo", &dir, &cases);
+    for (args, (_, err)) in cases.iter().zip(outs) {
         assert!(err.contains(args[args.len() - 1]), "{err}");
     }
     let out = run(common::fenestra("getinfo"), &dir, &["-"], Some(b"1 2 3\n"));

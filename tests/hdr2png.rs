@@ -29,14 +29,7 @@ fn decode(png: &[u8]) -> (u32, u32, Vec<u8>) {
 #[test]
 fn pictures_become_pngs_of_the_same_size() {
     let pic = common::fixture("threephase/img_t1_mar21_1000_clear.hdr");
-    let mut c = common::fenestra("hdr2png");
-    c.arg(&pic);
-    let out = c.output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = common::output_ok(common::fenestra("hdr2png").arg(&pic));
     assert!(String::from_utf8_lossy(&out.stderr).contains("exposure multiplier"));
     let (w, h, raw) = decode(&out.stdout);
     assert_eq!((w, h), (32, 26));
@@ -50,10 +43,7 @@ fn pictures_become_pngs_of_the_same_size() {
     assert!(px.iter().any(|&v| v > 20) && px.iter().any(|&v| v < 235));
     // false colour: the scale on stderr, a pure ramp colour in every pixel of the picture
     // (blue..red), and a legend strip to its right (the colour bar and black label text)
-    let mut c = common::fenestra("hdr2png");
-    c.args(["-f", "1000"]).arg(&pic);
-    let out = c.output().unwrap();
-    assert!(out.status.success());
+    let out = common::output_ok(common::fenestra("hdr2png").args(["-f", "1000"]).arg(&pic));
     assert!(String::from_utf8_lossy(&out.stderr).contains("1000.0000 (red) cd/m2"));
     let (w, h, raw) = decode(&out.stdout);
     assert!(w > 32 && h >= 26, "{w}×{h}");
@@ -89,19 +79,16 @@ fn pictures_become_pngs_of_the_same_size() {
 
 #[test]
 fn bad_input_is_refused() {
-    let dir = common::scratch("hdr2png-bad");
-    std::fs::write(dir.join("not.hdr"), "hello\n").unwrap();
-    for args in [
-        &["not.hdr"][..],
+    let dir = common::cli::scratch_files("hdr2png-bad", &[("not.hdr", "hello\n")]);
+    let cases: [&[&str]; 4] = [
+        &["not.hdr"],
         &["missing.hdr"],
         &["-g", "0", "not.hdr"],
         &["-q"],
-    ] {
-        let mut c = common::fenestra("hdr2png");
-        c.args(args).current_dir(&dir);
-        let out = c.output().unwrap();
-        assert!(!out.status.success(), "{args:?}");
-        assert!(out.stdout.is_empty(), "{args:?}: nothing written");
+    ];
+    let outs = common::cli::failures("hdr2png", &dir, &cases);
+    for (args, (stdout, _)) in cases.iter().zip(outs) {
+        assert!(stdout.is_empty(), "{args:?}: nothing written");
     }
     let _ = std::fs::remove_dir_all(&dir);
 }

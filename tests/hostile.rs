@@ -7,7 +7,7 @@ mod common;
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::path::Path;
-use std::process::{Command, Output, Stdio};
+use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use common::{fenestra, fixture, run_stdin, scratch};
@@ -17,6 +17,18 @@ fn run(tool: &str, args: &[&str], dir: &Path, input: &[u8]) -> Output {
     let mut c = fenestra(tool);
     c.args(args).current_dir(dir);
     run_stdin(c, input)
+}
+
+/// Starts one of our tools in `dir` with `io` as its stdin, stdout and stderr.
+fn spawn(tool: &str, args: &[&str], dir: &Path, io: [Stdio; 3]) -> Child {
+    let [input, output, errors] = io;
+    let mut c = fenestra(tool);
+    c.args(args)
+        .current_dir(dir)
+        .stdin(input)
+        .stdout(output)
+        .stderr(errors);
+    c.spawn().unwrap()
 }
 
 fn stderr(o: &Output) -> String {
@@ -67,6 +79,15 @@ const SKY23: &str =
 const V12: &str = "#?RADIANCE\nNROWS=1\nNCOLS=2\nNCOMP=3\nFORMAT=ascii\n\n1 1 1 0.5 0.5 0.5\n";
 /// A lit box: a glow source above a floor.
 const ROOM: &str = "void light bright\n0\n0\n3 10 10 10\nbright source sky\n0\n0\n4 0 0 1 180\nvoid plastic grey\n0\n0\n5 .5 .5 .5 0 0\ngrey polygon floor\n0\n0\n12 -5 -5 0 5 -5 0 5 5 0 -5 5 0\n";
+
+/// The files [`dc_dir`] writes.
+const DC_FILES: [&str; 3] = ["sky.mtx", "v.mtx", "room.rad"];
+
+/// Asserts that `dir` holds nothing but the files of [`dc_dir`].
+#[track_caller]
+fn assert_only_dc_files(dir: &Path) {
+    assert_eq!(others(dir, &DC_FILES), Vec::<String>::new());
+}
 
 fn dc_dir(name: &str) -> std::path::PathBuf {
     let d = scratch(name);
@@ -174,10 +195,7 @@ fn huge_output_field_width() {
         b"0 0 1 0 0 1\n",
     );
     clean_fail(&o, &["too large"]);
-    assert_eq!(
-        others(&d, &["sky.mtx", "v.mtx", "room.rad"]),
-        Vec::<String>::new()
-    );
+    assert_only_dc_files(&d);
 }
 
 /// Item 3: sizes in headers and scene files are checked against what can follow before
@@ -312,13 +330,8 @@ fn coprocess_answers_at_once() {
         ("rtrace", vec!["-h", "room.rad"]),
     ] {
         let flush_each = args.contains(&"-x");
-        let mut c = fenestra(tool);
-        c.args(&args)
-            .current_dir(&d)
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::null());
-        let mut child = c.spawn().unwrap();
+        let io = [Stdio::piped(), Stdio::piped(), Stdio::null()];
+        let mut child = spawn(tool, &args, &d, io);
         let mut stdin = child.stdin.take().unwrap();
         let lines = LineReader::new(child.stdout.take().unwrap());
         for _ in 0..3 {
@@ -354,13 +367,8 @@ fn coprocess_answers_at_once() {
 #[test]
 fn rtrace_memory_is_bounded() {
     let d = dc_dir("hostile-rss");
-    let mut c = fenestra("rtrace");
-    c.args(["-h", "-ab", "0", "-ff", "room.rad"])
-        .current_dir(&d)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped());
-    let mut child = c.spawn().unwrap();
+    let io = [Stdio::piped(), Stdio::piped(), Stdio::piped()];
+    let mut child = spawn("rtrace", &["-h", "-ab", "0", "-ff", "room.rad"], &d, io);
     let pid = child.id();
     let mut stdin = child.stdin.take().unwrap();
     let mut out = child.stdout.take().unwrap();
@@ -506,13 +514,8 @@ fn zero_radius_sphere_one_rule() {
 #[test]
 fn interrupted_output_leaves_nothing() {
     let d = dc_dir("hostile-kill");
-    let mut c = fenestra("dctimestep");
-    c.args(["-o", "ill.dat", "-", "sky.mtx"])
-        .current_dir(&d)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::null())
-        .stderr(Stdio::null());
-    let mut child = c.spawn().unwrap();
+    let io = [Stdio::piped(), Stdio::null(), Stdio::null()];
+    let mut child = spawn("dctimestep", &["-o", "ill.dat", "-", "sky.mtx"], &d, io);
     let mut stdin = child.stdin.take().unwrap();
     // a V matrix streamed slowly: the output is being written when the signal comes
     stdin
@@ -520,7 +523,7 @@ fn interrupted_output_leaves_nothing() {
         .unwrap();
     stdin.flush().unwrap();
     let t = Instant::now();
-    while others(&d, &["sky.mtx", "v.mtx", "room.rad"]).is_empty() {
+    while others(&d, &DC_FILES).is_empty() {
         assert!(
             t.elapsed() < Duration::from_secs(20),
             "no temporary output appeared"
@@ -535,10 +538,7 @@ fn interrupted_output_leaves_nothing() {
     let st = child.wait().unwrap();
     assert!(!st.success());
     drop(stdin);
-    assert_eq!(
-        others(&d, &["sky.mtx", "v.mtx", "room.rad"]),
-        Vec::<String>::new()
-    );
+    assert_only_dc_files(&d);
 }
 
 /// Item 14: xform arrays stream and are linear in their size.
@@ -546,22 +546,22 @@ fn interrupted_output_leaves_nothing() {
 fn xform_array_streams() {
     let d = dc_dir("hostile-xform");
     let t = Instant::now();
-    let o = run(
+    let out = clean_ok(&run(
         "xform",
         &["-a", "20000", "-rz", "0.3", "-t", "1", "0", "0", "room.rad"],
         &d,
         b"",
-    );
-    let out = clean_ok(&o);
+    ));
     assert_eq!(out.matches("polygon").count(), 20000);
     assert!(t.elapsed() < Duration::from_secs(20));
     // -a 10^8 | head: the first copies come at once
-    let mut c = fenestra("xform");
-    c.args(["-a", "100000000", "-rz", "1", "room.rad"])
-        .current_dir(&d)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null());
-    let mut child = c.spawn().unwrap();
+    let io = [Stdio::inherit(), Stdio::piped(), Stdio::null()];
+    let mut child = spawn(
+        "xform",
+        &["-a", "100000000", "-rz", "1", "room.rad"],
+        &d,
+        io,
+    );
     let lines = LineReader::new(child.stdout.take().unwrap());
     for _ in 0..50 {
         assert!(lines.next().is_some(), "no output from a huge array");
@@ -643,25 +643,16 @@ fn broken_inputs_fail_clearly() {
         &run("rmtxop", &["-"], &d, lying.as_bytes()),
         &["end of data"],
     );
-    // V with 2 columns against a 145-patch BSDF
+    // V with 2 columns against a 145-patch BSDF, and a BSDF XML cut in half
     let xml = fixture("threephase/blinds_kf.xml");
-    let o = run(
-        "dctimestep",
-        &["v.mtx", xml.to_str().unwrap(), "v.mtx", "sky.mtx"],
-        &d,
-        b"",
-    );
-    clean_fail(&o, &["145"]);
-    // a BSDF XML cut in half
     let text = std::fs::read(&xml).unwrap();
     std::fs::write(d.join("half.xml"), &text[..text.len() / 2]).unwrap();
-    let o = run(
-        "dctimestep",
-        &["v.mtx", "half.xml", "v.mtx", "sky.mtx"],
-        &d,
-        b"",
-    );
-    clean_fail(&o, &["half.xml"]);
+    for (bsdf, want) in [(xml.to_str().unwrap(), "145"), ("half.xml", "half.xml")] {
+        clean_fail(
+            &run("dctimestep", &["v.mtx", bsdf, "v.mtx", "sky.mtx"], &d, b""),
+            &[want],
+        );
+    }
     // scene and .cal syntax errors name file and line
     std::fs::write(d.join("bad.rad"), "void plastic m\n0\n0\n5 .5 .5 x 0 0\n").unwrap();
     clean_fail(&run("rtrace", &["bad.rad"], &d, b""), &["bad.rad:1", "'x'"]);

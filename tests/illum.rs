@@ -7,13 +7,7 @@ mod common;
 use std::process::Command;
 
 fn run(cmd: Command, input: &[u8]) -> Vec<f64> {
-    let out = common::run_stdin(cmd, input);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    common::numbers(&out.stdout)
+    common::numbers(&common::pipe_ok(cmd, input))
 }
 
 #[test]

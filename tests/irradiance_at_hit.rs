@@ -60,35 +60,14 @@ const TOL: f64 = 5e-5;
 /// Checks agreement within [`TOL`]; at least `min_lit` of the reference values are
 /// non-zero.
 fn compare(what: &str, theirs: &[f64], ours: &[f64], min_lit: usize) {
-    let lit = theirs.iter().filter(|v| **v > 0.0).count();
-    assert!(lit >= min_lit, "{what}: only {lit} lit values");
-    let worst = common::agree(what, theirs, ours, TOL, 1e-12);
-    eprintln!("{what}: largest relative difference {worst:.2e}");
-}
-
-fn run(mut c: std::process::Command, input: &str) -> Vec<f64> {
-    let out = common::run_stdin(
-        {
-            c.env("FENESTRA_NO_PROGRESS", "1");
-            c
-        },
-        input.as_bytes(),
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    common::numbers(&out.stdout)
+    common::probe::agree_lit(what, theirs, ours, min_lit, TOL, 1e-12);
 }
 
 #[test]
 fn oracle_irradiance_at_hit_through_antimatter_glass_and_trans() {
-    let Some(oracle) = common::oracle() else {
+    let Some((oracle, dir)) = common::probe::oracle_scene("irradiance_at_hit", LAMPS) else {
         return;
     };
-    let dir = common::scratch("irradiance_at_hit");
-    std::fs::write(dir.join("scene.rad"), LAMPS).unwrap();
     let input = lamp_rays();
     let (t, o) = common::both_rtrace(&oracle, &dir, &["-h", "-i", "-ab", "0", "-dt", "0"], &input);
     compare("rtrace -i", &t, &o, 72);
@@ -96,11 +75,7 @@ fn oracle_irradiance_at_hit_through_antimatter_glass_and_trans() {
     let ropts = [
         "-h", "-i", "-V+", "-ab", "0", "-dj", "0", "-m", "lamp", "-m", "lamp2",
     ];
-    let mut theirs = oracle.command("rcontrib");
-    theirs.args(ropts).arg("scene.oct").current_dir(&dir);
-    let mut ours = common::fenestra("rcontrib");
-    ours.args(ropts).arg("scene.rad").current_dir(&dir);
-    let (tt, oo) = (run(theirs, &input), run(ours, &input));
+    let (tt, oo) = common::probe::both(&oracle, &dir, "rcontrib", &ropts, &input);
     compare("rcontrib -i", &tt, &oo, 96);
     // the two lamps' contributions add up to rtrace's value (red channel)
     for (k, v) in o.chunks(3).enumerate() {
@@ -119,11 +94,7 @@ fn oracle_irradiance_at_hit_through_antimatter_glass_and_trans() {
     let sopts = [
         "-h", "-i", "-V+", "-ab", "0", "-dj", "0", "-m", "w", "-m", "g", "-m", "t", "-m", "hole",
     ];
-    let mut theirs = oracle.command("rcontrib");
-    theirs.args(sopts).arg("scene.oct").current_dir(&dir);
-    let mut ours = common::fenestra("rcontrib");
-    ours.args(sopts).arg("scene.rad").current_dir(&dir);
-    let (tt, oo) = (run(theirs, &input), run(ours, &input));
+    let (tt, oo) = common::probe::both(&oracle, &dir, "rcontrib", &sopts, &input);
     compare("rcontrib -i -m w -m g -m t -m hole", &tt, &oo, 120);
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -149,23 +120,19 @@ w polygon floor 0 0 12 -5 -5 0 5 -5 0 5 5 0 -5 5 0
 /// the wall).
 #[test]
 fn oracle_irradiance_at_hit_inside_antimatter_under_a_sky() {
-    let Some(oracle) = common::oracle() else {
+    let Some((oracle, dir)) = common::probe::oracle_scene("irradiance_at_hit_sky", SKY) else {
         return;
     };
-    let dir = common::scratch("irradiance_at_hit_sky");
-    std::fs::write(dir.join("scene.rad"), SKY).unwrap();
     let input = "0 0 0.1 0 0 -1\n0 0 0.5 0 0 -1\n0 0 2.5 0 0 -1\n";
     let opts = [
         "-h", "-i", "-ab", "1", "-ad", "4000", "-aa", "0", "-lw", "1e-4",
     ];
     let (t, o) = common::both_rtrace(&oracle, &dir, &opts, input);
-    let mut ours = common::fenestra("rcontrib");
-    ours.args([
+    let ropts = [
         "-h", "-i", "-V+", "-ab", "1", "-ad", "4000", "-lw", "1e-4", "-m", "sky",
-    ])
-    .arg("scene.rad")
-    .current_dir(&dir);
-    let rc = run(ours, input);
+    ];
+    let rc = common::probe::ours("rcontrib", &dir, &ropts, "scene.rad", input.as_bytes());
+    let rc = common::numbers(&rc.stdout);
     // Exact values: on the floor, the sky through the hole (tan = 0.8: pi sin^2 =
     // 1.22599) and beyond the wall's edges (0.09947, by quadrature); on the sphere's
     // lowest point, the sky within 45 degrees of the zenith (pi / 2).
@@ -201,24 +168,16 @@ fn oracle_irradiance_at_hit_inside_antimatter_under_a_sky() {
 
 #[test]
 fn irradiance_at_hit_is_the_same_for_any_thread_count() {
-    let dir = common::scratch("irradiance_at_hit_threads");
-    std::fs::write(dir.join("scene.rad"), LAMPS).unwrap();
+    let dir = common::probe::scene_dir("irradiance_at_hit_threads", LAMPS);
     let input = lamp_rays().repeat(4);
     let mut outs = Vec::new();
     for n in ["1", "2"] {
         for tool in ["rtrace", "rcontrib"] {
-            let mut c = common::fenestra(tool);
-            c.args(["-h", "-i", "-ab", "1", "-ad", "64", "-n", n]);
+            let mut args = vec!["-h", "-i", "-ab", "1", "-ad", "64", "-n", n];
             if tool == "rcontrib" {
-                c.args(["-m", "lamp", "-m", "w"]);
+                args.extend(["-m", "lamp", "-m", "w"]);
             }
-            c.arg("scene.rad").current_dir(&dir);
-            let out = common::run_stdin(c, input.as_bytes());
-            assert!(
-                out.status.success(),
-                "{}",
-                String::from_utf8_lossy(&out.stderr)
-            );
+            let out = common::probe::ours(tool, &dir, &args, "scene.rad", input.as_bytes());
             outs.push(out.stdout);
         }
     }

@@ -32,27 +32,13 @@ fn points() -> String {
 
 #[test]
 fn oracle_mirror_relays_the_sun() {
-    let Some(oracle) = common::oracle() else {
+    let Some((oracle, dir)) = common::probe::oracle_scene("mirror", SCENE) else {
         return;
     };
-    let dir = common::scratch("mirror");
-    std::fs::write(dir.join("scene.rad"), SCENE).unwrap();
-    let mut c = oracle.command("oconv");
-    c.arg("scene.rad").current_dir(&dir);
-    std::fs::write(dir.join("s.oct"), common::run_ok(&mut c)).unwrap();
     // -ab 0, no jitter: direct light only, deterministic in both tools.
     for dr in ["2", "0"] {
         let opts = ["-h", "-I+", "-ab", "0", "-dj", "0", "-u-", "-dr", dr];
-        let mut t = oracle.command("rtrace");
-        t.args(opts).arg("s.oct").current_dir(&dir);
-        let t = common::run_stdin(t, points().as_bytes());
-        assert!(t.status.success(), "{}", String::from_utf8_lossy(&t.stderr));
-        let mut o = common::fenestra("rtrace");
-        o.args(opts).arg("scene.rad").current_dir(&dir);
-        let o = common::run_stdin(o, points().as_bytes());
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let (t, o) = (common::numbers(&t.stdout), common::numbers(&o.stdout));
-        assert_eq!(t.len(), o.len());
+        let (t, o) = common::both_rtrace(&oracle, &dir, &opts, &points());
         let direct = 1e6 * 2.0 * std::f64::consts::PI * (1.0 - 0.25f64.to_radians().cos()) * 0.866;
         let lit = t.iter().filter(|v| **v > 1.2 * direct).count();
         if dr == "2" {
@@ -60,12 +46,7 @@ fn oracle_mirror_relays_the_sun() {
         } else {
             assert_eq!(lit, 0, "-dr 0: no relayed light");
         }
-        for (k, (a, b)) in t.iter().zip(&o).enumerate() {
-            // Six printed digits and float colours.
-            assert!(
-                (a - b).abs() <= 2e-5 * a.abs().max(1e-3),
-                "-dr {dr}: value {k}: oracle {a} ours {b}"
-            );
-        }
+        // Six printed digits and float colours.
+        common::probe::agree_6_digits(&t, &o, |k| format!("-dr {dr}: value {k}: "));
     }
 }

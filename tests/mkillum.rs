@@ -426,16 +426,10 @@ fn same_output_for_any_thread_count() {
         .unwrap();
         let mut mk = ours(&d);
         mk.args(["-n", n, "-ab", "1", "-ad", "32", "scene.rad"]);
-        let out = common::run_stdin(
+        let mut all = common::pipe_ok(
             mk,
             b"#@mkillum c=d d=6 s=6\nvoid polygon w 0 0 12 0 0 0 0 0.5 0 0.5 0.5 0 0.5 0 0\n",
         );
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let mut all = out.stdout.clone();
         for f in ["illumR.dat", "illumG.dat", "illumB.dat"] {
             all.extend(std::fs::read(d.join(f)).unwrap());
         }
@@ -616,18 +610,13 @@ fn native_illum_patterns_give_the_cal_engine_s_numbers() {
     .unwrap();
     let mut mk = ours(&dir);
     mk.args(["-ab", "1", "-ad", "64", "scene.rad"]);
-    let out = common::run_stdin(
+    let out = common::pipe_ok(
         mk,
         b"#@mkillum c=d d=12 s=4 m=a\nvoid polygon w 0 0 12 0 0 0 0 0.5 0 0.5 0.5 0 0.5 0 0\n\
           #@mkillum c=n m=b\nvoid polygon w2 0 0 12 1 0 0 1 0.5 0 1.5 0.5 0 1.5 0 0\n\
           #@mkillum m=c\nvoid sphere s 0 0 4 0 0 5 0.3\n",
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    std::fs::write(dir.join("illum.rad"), &out.stdout).unwrap();
+    std::fs::write(dir.join("illum.rad"), out).unwrap();
     std::fs::create_dir_all(dir.join("alt")).unwrap();
     let mut cal = std::fs::read_to_string(common::fenestra_lib().join("illum.cal")).unwrap();
     cal.push_str("{ a copy: not the shipped text }\n");
@@ -684,13 +673,8 @@ fn bsdf_mode_lux_with(dir: &Path, sky: &str, xml: &str) -> Vec<f64> {
         "1e-4",
         "outside.oct",
     ]);
-    let out = common::run_stdin(mk, input.as_bytes());
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    std::fs::write(dir.join("illum.rad"), &out.stdout).unwrap();
+    let illum = common::pipe_ok(mk, input.as_bytes());
+    std::fs::write(dir.join("illum.rad"), illum).unwrap();
     let mut oconv = common::fenestra("oconv");
     oconv
         .arg("-f")

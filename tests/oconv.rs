@@ -29,10 +29,7 @@ fn compiled_scene_round_trips() {
         head.starts_with("#?FENESTRA_SCENE\nFORMAT=fenestra_scene\nVERSION=1\n"),
         "{head}"
     );
-    assert!(
-        head.contains("INPUT=") && head.contains("room.rad"),
-        "{head}"
-    );
+    common::cli::assert_contains(&head, &["INPUT=", "room.rad"]);
     let refs: Vec<&str> = files.iter().map(String::as_str).collect();
     let direct = fenestra_scene::load(&refs).unwrap();
     let c = fenestra_scene::compiled::read_file(oct.to_str().unwrap()).unwrap();
@@ -57,13 +54,11 @@ fn compiled_scene_round_trips() {
 #[test]
 fn a_damaged_radiance_octree_is_reported() {
     // a header and a magic number, then the data stop: "truncated octree", naming the file
-    let d = common::scratch("oconv-radoct");
-    let f = d.join("rad.oct");
-    std::fs::write(
-        &f,
+    let f = common::cli::scratch_file(
+        "oconv-radoct",
+        "rad.oct",
         b"#?RADIANCE\noconv room.rad\nFORMAT=Radiance_octree\n\n\x01\x1f-1.5\0",
-    )
-    .unwrap();
+    );
     let e = fenestra_scene::load(&[f.to_str().unwrap()]).unwrap_err();
     let msg = format!("{e:#}");
     assert!(

@@ -28,47 +28,38 @@ void light sunlit 0 0 3 1e5 1e5 1e5
 sunlit source sun 0 0 4 .3 .2 1 .5
 ";
 
+/// The records `rays(k, a)` for k = 0, 1, … n − 1 at angles a = k × `step`.
+fn fan(n: u32, step: f64, rays: impl Fn(f64, f64) -> String) -> String {
+    (0..n).map(|k| rays(k as f64, k as f64 * step)).collect()
+}
+
 /// Rays: some straight at the (patterned) sky, some down at the (patterned) floor.
 fn rays() -> String {
-    let mut s = String::new();
-    for k in 0..24 {
-        let a = k as f64 * 0.26;
-        s.push_str(&format!(
-            "0 0 1 {} {} {}\n",
-            a.cos() * 0.6,
-            a.sin() * 0.6,
-            0.8
-        ));
-        s.push_str(&format!(
+    fan(24, 0.26, |_, a| {
+        let sky = format!("0 0 1 {} {} {}\n", a.cos() * 0.6, a.sin() * 0.6, 0.8);
+        let floor = format!(
             "{} {} 2 {} {} -1\n",
             a.cos() * 0.3,
             a.sin(),
             a.sin() * 0.4,
             a.cos() * 0.2
-        ));
-    }
-    s
+        );
+        sky + &floor
+    })
 }
 
 #[test]
 fn oracle_cal_patterns_match_rtrace() {
-    let Some(oracle) = common::oracle() else {
+    let Some((oracle, dir)) = common::probe::oracle_scene("patterns", SCENE) else {
         return;
     };
-    let dir = common::scratch("patterns");
     std::fs::write(dir.join("pats.cal"), CAL).unwrap();
-    std::fs::write(dir.join("scene.rad"), SCENE).unwrap();
     // -ab 0 and no jitter (-dj 0, -ds 0): direct light and sky values are deterministic.
     let opts = ["-h", "-ab", "0", "-dj", "0", "-ds", "0", "-u-"];
     let (t, o) = common::both_rtrace(&oracle, &dir, &opts, &rays());
     assert!(t.iter().any(|v| *v > 0.0));
-    for (k, (a, b)) in t.iter().zip(&o).enumerate() {
-        // rtrace prints 6 significant digits and keeps colours in single precision.
-        assert!(
-            (a - b).abs() <= 2e-5 * a.abs().max(1e-3),
-            "value {k}: oracle {a} ours {b}"
-        );
-    }
+    // rtrace prints 6 significant digits and keeps colours in single precision.
+    common::probe::agree_6_digits(&t, &o, |k| format!("value {k}: "));
 }
 
 #[test]
@@ -104,10 +95,9 @@ fn pattern_errors_are_clear() {
 /// transform, against the reference rtrace.
 #[test]
 fn oracle_pattern_transforms_match_rtrace() {
-    let Some(oracle) = common::oracle() else {
+    let Some((oracle, dir)) = common::probe::oracle_dir("patterns_xf") else {
         return;
     };
-    let dir = common::scratch("patterns_xf");
     std::fs::write(dir.join("ramp.dat"), "1\n-3 3 5\n1 2 4 3 2.5\n").unwrap();
     let vars = [
         "Dx", "Dy", "Dz", "Nx", "Ny", "Nz", "Px", "Py", "Pz", "T", "Ts", "Rdot", "S", "Tx", "Ty",
@@ -132,15 +122,14 @@ fn oracle_pattern_transforms_match_rtrace() {
             std::fs::write(dir.join("scene.rad"), scene).unwrap();
             let (t, o) = common::both_rtrace(&oracle, &dir, &["-h", "-ab", "0", "-u-"], rays);
             assert_eq!(t.len(), 9);
-            for (j, (a, b)) in t.iter().zip(&o).enumerate() {
-                // 6 printed digits; single-precision colours in Radiance.
-                assert!(
-                    (a - b).abs() <= 2e-5 * a.abs().max(1e-3),
-                    "{xf}: {} on ray {}: oracle {a} ours {b}",
+            // 6 printed digits; single-precision colours in Radiance.
+            common::probe::agree_6_digits(&t, &o, |j| {
+                format!(
+                    "{xf}: {} on ray {}: ",
                     chunk.get(j % 3).unwrap_or(&"0"),
                     j / 3
-                );
-            }
+                )
+            });
         }
     }
     let scene = "void brightdata ramp 10 noneg ramp.dat . Px -rz 30 -t 1 0 0\n0\n0\n\
@@ -156,26 +145,11 @@ fn oracle_pattern_transforms_match_rtrace() {
     }
     let (t, o) = common::both_rtrace(&oracle, &dir, &["-h", "-ab", "0", "-u-"], &rays);
     assert_eq!(t.len(), 60);
-    for (k, (a, b)) in t.iter().zip(&o).enumerate() {
-        assert!(
-            (a - b).abs() <= 2e-5 * a.abs().max(1e-3),
-            "brightdata, value {k}: oracle {a} ours {b}"
-        );
-    }
+    common::probe::agree_6_digits(&t, &o, |k| format!("brightdata, value {k}: "));
 }
 
 #[test]
 fn oracle_data_patterns_match_rtrace() {
-    let Some(oracle) = common::oracle() else {
-        return;
-    };
-    let dir = common::scratch("datapatterns");
-    for c in ["R", "G", "B"] {
-        let f = format!("ill_glass{c}.dat");
-        std::fs::copy(common::fixture("datapattern").join(&f), dir.join(&f)).unwrap();
-    }
-    // A 1-D file for brightdata, with coordinates beyond its ends (linear extension).
-    std::fs::write(dir.join("ramp.dat"), "1\n-.5 .5 5\n1 2 4 3 2.5\n").unwrap();
     let scene = "
 void colordata illum_mat.dist
 9 red green blue ill_glassR.dat ill_glassG.dat ill_glassB.dat illum.cal il_alth il_azih
@@ -190,46 +164,38 @@ void brightdata ramp 4 noneg ramp.dat . 2*Dx
 ramp glow wall 0 0 4 .5 .5 .5 0
 wall polygon back 0 0 12  -2 5 3  2 5 3  2 5 0  -2 5 0
 ";
-    std::fs::write(dir.join("scene.rad"), scene).unwrap();
-    let mut rays = String::new();
-    for k in 0..40 {
-        let a = k as f64 * 0.157;
-        // from inside the room (y < 0) toward the window panel at y = 0
-        rays.push_str(&format!(
-            "2 -1.5 1.6 {} 1 {}\n",
-            a.cos() * 0.6,
-            a.sin() * 0.4
-        ));
-        // toward the far wall at y = 5, Dx spanning beyond [-.5, .5]
-        rays.push_str(&format!("0 0 1.5 {} 1 0\n", (k as f64 - 20.0) / 50.0));
+    let Some((oracle, dir)) = common::probe::oracle_scene("datapatterns", scene) else {
+        return;
+    };
+    for c in ["R", "G", "B"] {
+        let f = format!("ill_glass{c}.dat");
+        std::fs::copy(common::fixture("datapattern").join(&f), dir.join(&f)).unwrap();
     }
+    // A 1-D file for brightdata, with coordinates beyond its ends (linear extension).
+    std::fs::write(dir.join("ramp.dat"), "1\n-.5 .5 5\n1 2 4 3 2.5\n").unwrap();
+    let rays = fan(40, 0.157, |k, a| {
+        // from inside the room (y < 0) toward the window panel at y = 0
+        let window = format!("2 -1.5 1.6 {} 1 {}\n", a.cos() * 0.6, a.sin() * 0.4);
+        // toward the far wall at y = 5, Dx spanning beyond [-.5, .5]
+        window + &format!("0 0 1.5 {} 1 0\n", (k - 20.0) / 50.0)
+    });
     let opts = ["-h", "-ab", "0", "-u-"];
     let (t, o) = common::both_rtrace(&oracle, &dir, &opts, &rays);
     assert_eq!(t.len(), o.len());
     assert!(t.iter().filter(|v| **v > 0.0).count() > 100);
-    for (k, (a, b)) in t.iter().zip(&o).enumerate() {
-        // 6 printed digits; single-precision colours in Radiance.
-        assert!(
-            (a - b).abs() <= 2e-5 * a.abs().max(1e-3),
-            "value {k} (ray {}): oracle {a} ours {b}",
-            k / 3
-        );
-    }
+    // 6 printed digits; single-precision colours in Radiance.
+    common::probe::agree_6_digits(&t, &o, |k| format!("value {k} (ray {}): ", k / 3));
 }
 
 /// `-e` and `-f` definitions are visible to every pattern (Radiance's global context).
 #[test]
 fn oracle_e_and_f_reach_patterns() {
-    let Some(oracle) = common::oracle() else {
+    let scene = "void brightfunc sp 2 skyv . 0 0\nsp glow g 0 0 4 1 .8 .6 0\n\
+                 g source s 0 0 4 0 0 1 180\n";
+    let Some((oracle, dir)) = common::probe::oracle_scene("patterns_ef", scene) else {
         return;
     };
-    let dir = common::scratch("patterns_ef");
     std::fs::write(dir.join("defs.cal"), "shape(z) = 1 + gain*z*z;\n").unwrap();
-    std::fs::write(
-        dir.join("scene.rad"),
-        "void brightfunc sp 2 skyv . 0 0\nsp glow g 0 0 4 1 .8 .6 0\ng source s 0 0 4 0 0 1 180\n",
-    )
-    .unwrap();
     let opts = [
         "-h",
         "-ab",
@@ -245,10 +211,5 @@ fn oracle_e_and_f_reach_patterns() {
         .collect();
     let (t, o) = common::both_rtrace(&oracle, &dir, &opts, &rays);
     assert_eq!(t.len(), 30);
-    for (a, b) in t.iter().zip(&o) {
-        assert!(
-            (a - b).abs() <= 2e-5 * a.abs().max(1e-3),
-            "oracle {a} ours {b}"
-        );
-    }
+    common::probe::agree_6_digits(&t, &o, |_| String::new());
 }

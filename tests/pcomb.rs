@@ -98,14 +98,10 @@ fn size_mismatch_and_bad_input_are_clear_errors() {
             "-x 0",
         ),
     ] {
-        let out = common::fenestra("pcomb")
-            .current_dir(&dir)
-            .args(&args)
-            .output()
-            .unwrap();
-        assert!(!out.status.success(), "{args:?}");
-        assert!(out.stdout.is_empty(), "{args:?}: no partial output");
-        let err = String::from_utf8_lossy(&out.stderr);
+        let mut c = common::fenestra("pcomb");
+        c.current_dir(&dir).args(&args);
+        let (stdout, err) = common::output_err(&mut c, &format!("{args:?}"));
+        assert!(stdout.is_empty(), "{args:?}: no partial output");
         assert!(
             err.starts_with("pcomb: fatal - ") && err.contains(want),
             "{args:?}: {err}"

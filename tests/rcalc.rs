@@ -4,31 +4,37 @@
 
 mod common;
 
-use std::io::Write;
 use std::path::Path;
-use std::process::{Command, Stdio};
+use std::process::Command;
 
-/// Runs a command with `input` on stdin; returns (success, stdout, stderr).
-fn run_with(mut cmd: Command, input: &[u8]) -> (bool, String, String) {
-    let mut child = cmd
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap_or_else(|e| panic!("cannot run {cmd:?}: {e}"));
-    let mut stdin = child.stdin.take().unwrap();
-    let data = input.to_vec();
-    let feeder = std::thread::spawn(move || {
-        // A program that fails early may close its input: ignore the broken pipe.
-        let _ = stdin.write_all(&data);
-    });
-    let out = child.wait_with_output().unwrap();
-    let _ = feeder.join();
+/// A run's (success, stdout, stderr).
+type Run = (bool, String, String);
+
+/// Runs a command with `input` on stdin (a program that fails early may close its input: the
+/// broken pipe is ignored); returns (success, stdout, stderr).
+fn run_with(cmd: Command, input: &[u8]) -> Run {
+    let out = common::run_stdin(cmd, input);
     (
         out.status.success(),
         String::from_utf8_lossy(&out.stdout).into_owned(),
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
+}
+
+/// The oracle's rcalc and ours with `args` on `input`: (theirs, ours).
+fn both(o: &common::Oracle, args: &[&str], input: &[u8]) -> (Run, Run) {
+    let mut oc = o.command("rcalc");
+    oc.args(args);
+    (run_with(oc, input), run_with(ours(args), input))
+}
+
+/// The oracle's rcalc and ours with `-e prog` on `input`, asserting both succeed with the same
+/// output; returns their error output (theirs, ours).
+fn same_output(o: &common::Oracle, prog: &str, input: &[u8]) -> (String, String) {
+    let ((ok_o, out_o, err_o), (ok_f, out_f, err_f)) = both(o, &["-e", prog], input);
+    assert!(ok_o && ok_f, "{prog}: {err_f}");
+    assert_eq!(out_f, out_o, "{prog}");
+    (err_o, err_f)
 }
 
 /// Our rcalc with our lib/ on RAYPATH.
@@ -125,10 +131,7 @@ fn oracle_rayinit_functions() {
         let input = grid_records(grid, *n);
         let prog = format!("{vecs}$1={expr}");
         let args = ["-f", "rayinit.cal", "-e", &prog];
-        let mut oc = o.command("rcalc");
-        oc.args(args);
-        let (ook, oout, oerr) = run_with(oc, input.as_bytes());
-        let (fok, fout, ferr) = run_with(ours(&args), input.as_bytes());
+        let ((ook, oout, oerr), (fok, fout, ferr)) = both(&o, &args, input.as_bytes());
         assert_eq!(
             ook, fok,
             "{expr}: exit status differs\noracle: {oerr}\nours: {ferr}"
@@ -161,10 +164,7 @@ fn oracle_rayinit_renderer_names_fail_in_rcalc() {
     ] {
         let prog = format!("$1={expr}");
         let args = ["-n", "-f", "rayinit.cal", "-e", &prog];
-        let mut oc = o.command("rcalc");
-        oc.args(args);
-        let (ook, _, _) = run_with(oc, b"");
-        let (fok, _, ferr) = run_with(ours(&args), b"");
+        let ((ook, _, _), (fok, _, ferr)) = both(&o, &args, b"");
         assert!(!ook, "oracle accepted {expr}");
         assert!(!fok, "we accepted {expr}");
         assert!(ferr.contains("rayinit.cal"), "{expr}: {ferr}");
@@ -326,11 +326,8 @@ fn oracle_tregenza_bins() {
         "-e",
         "Dx=$1;Dy=$2;Dz=$3;$1=tbin;$2=Ntbins",
     ];
-    let mut oc = o.command("rcalc");
-    oc.args(args);
-    let (ook, oout, oerr) = run_with(oc, input.as_bytes());
+    let ((ook, oout, oerr), (fok, fout, ferr)) = both(&o, &args, input.as_bytes());
     assert!(ook, "{oerr}");
-    let (fok, fout, ferr) = run_with(ours(&args), input.as_bytes());
     assert!(fok, "{ferr}");
     let mut differ = 0;
     for ((r, a), b) in rows.iter().zip(oout.lines()).zip(fout.lines()) {
@@ -508,10 +505,7 @@ fn oracle_generated_corpus() {
     }
     let (mut same, mut both_fail, mut nan_differ, mut differ) = (0, 0, 0, Vec::new());
     for p in &progs {
-        let mut oc = o.command("rcalc");
-        oc.args(["-e", p]);
-        let (ook, oout, oerr) = run_with(oc, input.as_bytes());
-        let (fok, fout, ferr) = run_with(ours(&["-e", p]), input.as_bytes());
+        let ((ook, oout, oerr), (fok, fout, ferr)) = both(&o, &["-e", p], input.as_bytes());
         if !ook || !fok {
             assert_eq!(
                 ook, fok,
@@ -647,12 +641,7 @@ fn oracle_input_words_read_as_c_atof() {
     let Some(o) = common::oracle() else { return };
     let input = b"-0\n0\n0x10\n-0x1.8p1\n0X1P-2\n0x\n1e3x\n-.5e1\nnan\n-inf\nabc\n";
     for e in ["$1=$1", "$1=-$1;$2=$1*2"] {
-        let mut theirs = o.command("rcalc");
-        theirs.args(["-e", e]);
-        let (ok_o, out_o, _) = run_with(theirs, input);
-        let (ok_f, out_f, err_f) = run_with(ours(&["-e", e]), input);
-        assert!(ok_o && ok_f, "{e}: {err_f}");
-        assert_eq!(out_f, out_o, "{e}");
+        same_output(&o, e, input);
     }
 }
 
@@ -669,12 +658,7 @@ fn oracle_zero_rules() {
     let warnings = |err: &str| err.matches("Division by zero").count();
     let mut n = 0;
     for e in progs.lines().filter(|l| !l.trim().is_empty()) {
-        let mut theirs = o.command("rcalc");
-        theirs.args(["-e", e]);
-        let (ok_o, out_o, err_o) = run_with(theirs, input);
-        let (ok_f, out_f, err_f) = run_with(ours(&["-e", e]), input);
-        assert!(ok_o && ok_f, "{e}: {err_f}");
-        assert_eq!(out_f, out_o, "{e}");
+        let (err_o, err_f) = same_output(&o, e, input);
         assert_eq!(
             warnings(&err_f),
             warnings(&err_o),
@@ -723,11 +707,8 @@ fn oracle_rcalc_runs_our_bin_files() {
             args.extend(["-e", pre.as_str()]);
         }
         args.extend(["-f", path, "-e", prog.as_str()]);
-        let mut oc = o.command("rcalc");
-        oc.args(&args);
-        let (ook, oout, oerr) = run_with(oc, input.as_bytes());
+        let ((ook, oout, oerr), (fok, fout, ferr)) = both(&o, &args, input.as_bytes());
         assert!(ook, "{oerr}");
-        let (fok, fout, ferr) = run_with(ours(&args), input.as_bytes());
         assert!(fok, "{ferr}");
         assert_eq!(oout.lines().count(), 7 * rows.len(), "{file} {pre}");
         assert_eq!(

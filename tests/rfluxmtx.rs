@@ -252,13 +252,7 @@ fn reference_office_v_and_d_reproduce_radiance_rfluxmtx() {
     );
     v.arg(tp("window_rflux.rad")).args(office());
     let pts = std::fs::read(common::fixture("rtrace_threephase_bsdf").join("sensors.pts")).unwrap();
-    let out = common::run_stdin(v, &pts);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    std::fs::write(dir.join("V.vmx"), &out.stdout).unwrap();
+    std::fs::write(dir.join("V.vmx"), common::pipe_ok(v, &pts)).unwrap();
     let total = |m: &[Vec<[f64; 3]>]| -> f64 { m.iter().flatten().map(|c| c[1]).sum() };
     let (dm, dr) = (
         matrix(&dir.join("D.dmx")),
@@ -361,13 +355,7 @@ fn rfluxmtx_and_genklemsamp_rtcontrib_sample_the_same_d() {
     ])
     .arg(tp("sky_rflux.rad"))
     .args(&scene);
-    let out = common::run_stdin(rc, &rays);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    std::fs::write(dir.join("gk.dmx"), &out.stdout).unwrap();
+    std::fs::write(dir.join("gk.dmx"), common::pipe_ok(rc, &rays)).unwrap();
     let (a, b) = (matrix(&dir.join("rf.dmx")), matrix(&dir.join("gk.dmx")));
     assert_eq!((a.len(), a[0].len()), (b.len(), b[0].len()));
     let (mut ta, mut tb) = (0.0, 0.0);
@@ -416,12 +404,7 @@ fn five_thousand_receivers_in_one_call() {
     // 100 x 50 ceiling tiles, direct only; the tiles cover the view from the sender's centre
     // out to 63 degrees, so the row sum equals the fraction of cosine-weighted rays within
     // reach of the grid up to the origin spread (checked loosely: between 0.6 and 0.95).
-    let dir = common::scratch("rflux-many");
-    std::fs::write(
-        dir.join("snd.rad"),
-        "#@rfluxmtx h=u u=Y\nvoid glow s 0 0 4 1 1 1 0\ns polygon snd 0 0 12 -.1 -.1 0 -.1 .1 0 .1 .1 0 .1 -.1 0\n",
-    )
-    .unwrap();
+    let snd = "#@rfluxmtx h=u u=Y\nvoid glow s 0 0 4 1 1 1 0\ns polygon snd 0 0 12 -.1 -.1 0 -.1 .1 0 .1 .1 0 .1 -.1 0\n";
     let mut r = String::new();
     for i in 0..100 {
         for j in 0..50 {
@@ -433,7 +416,8 @@ fn five_thousand_receivers_in_one_call() {
             ));
         }
     }
-    std::fs::write(dir.join("rcv.rad"), r).unwrap();
+    let files = [("snd.rad", snd), ("rcv.rad", r.as_str())];
+    let dir = common::cli::scratch_files("rflux-many", &files);
     let out = common::run_ok(&mut ours(
         &dir,
         &["-ab", "0", "-c", "2000", "-faa", "snd.rad", "rcv.rad"],
@@ -449,10 +433,7 @@ fn five_thousand_receivers_in_one_call() {
 }
 
 fn refused(files: &[(&str, &str)], args: &[&str], want: &str) {
-    let dir = common::scratch("rflux-errors");
-    for (n, t) in files {
-        std::fs::write(dir.join(n), t).unwrap();
-    }
+    let dir = common::cli::scratch_files("rflux-errors", files);
     let out = ours(&dir, args).output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success(), "{args:?} succeeded");

@@ -14,6 +14,33 @@ fn tp() -> PathBuf {
     common::fixture("threephase")
 }
 
+/// A fresh scratch folder `name` holding copies of the three-phase fixtures `files`.
+fn scratch_with(name: &str, files: &[&str]) -> PathBuf {
+    let dir = common::scratch(name);
+    for f in files {
+        std::fs::copy(tp().join(f), dir.join(f)).unwrap();
+    }
+    dir
+}
+
+/// The three-phase fixtures of [`oracle_operations_are_byte_identical`].
+const OPS_FIXTURES: [&str; 7] = [
+    "T.mtx",
+    "D_rflux.dmx",
+    "test.m1.smx",
+    "blinds_kf.xml",
+    "sawtooth.xml",
+    "res_t1_mar21_1000_clear.dat",
+    "img_t1_mar21_1000_clear.hdr",
+];
+
+/// The three-phase fixtures of [`oracle_streamed_conversion_is_identical`].
+const STREAM_FIXTURES: [&str; 3] = [
+    "T.mtx",
+    "res_t1_mar21_1000_clear.dat",
+    "img_t1_mar21_1000_clear.hdr",
+];
+
 fn run(mut c: Command, dir: &Path, args: &[String]) -> Output {
     c.current_dir(dir)
         .args(args)
@@ -69,11 +96,7 @@ fn lux_conversion_reproduces_stored_oracle_output() {
             &tp(),
             &words(&format!("-fa -c 47.435 119.93 11.635 {res}")),
         );
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        common::assert_ok(&out);
         let want = std::fs::read(common::fixture(&format!("matrices/{ill}"))).unwrap();
         assert!(out.stdout == want, "{ill} not reproduced");
     }
@@ -162,18 +185,7 @@ fn oracle_format_conversions_are_byte_identical() {
 #[test]
 fn oracle_operations_are_byte_identical() {
     let Some(o) = common::oracle() else { return };
-    let dir = common::scratch("rmtxop-ops");
-    for f in [
-        "T.mtx",
-        "D_rflux.dmx",
-        "test.m1.smx",
-        "blinds_kf.xml",
-        "sawtooth.xml",
-        "res_t1_mar21_1000_clear.dat",
-        "img_t1_mar21_1000_clear.hdr",
-    ] {
-        std::fs::copy(tp().join(f), dir.join(f)).unwrap();
-    }
+    let dir = scratch_with("rmtxop-ops", &OPS_FIXTURES);
     for f in ["m23h.txt", "m32h.txt"] {
         std::fs::copy(common::fixture(&format!("matrices/{f}")), dir.join(f)).unwrap();
     }
@@ -249,10 +261,10 @@ fn oracle_operations_are_byte_identical() {
 #[test]
 fn oracle_xml_luminance_agrees() {
     let Some(o) = common::oracle() else { return };
-    let dir = common::scratch("rmtxop-xml");
-    for f in ["blinds_kf.xml", "D_rflux.dmx", "sawtooth.xml"] {
-        std::fs::copy(tp().join(f), dir.join(f)).unwrap();
-    }
+    let dir = scratch_with(
+        "rmtxop-xml",
+        &["blinds_kf.xml", "D_rflux.dmx", "sawtooth.xml"],
+    );
     for case in [
         "-fd -c .265 .670 .065 -rf blinds_kf.xml",
         "-fd -c .265 .670 .065 -rb blinds_kf.xml",
@@ -433,14 +445,7 @@ fn mutated_inputs_never_panic() {
 #[test]
 fn oracle_streamed_conversion_is_identical() {
     let Some(o) = common::oracle() else { return };
-    let dir = common::scratch("rmtxop-stream");
-    for f in [
-        "T.mtx",
-        "res_t1_mar21_1000_clear.dat",
-        "img_t1_mar21_1000_clear.hdr",
-    ] {
-        std::fs::copy(tp().join(f), dir.join(f)).unwrap();
-    }
+    let dir = scratch_with("rmtxop-stream", &STREAM_FIXTURES);
     for case in [
         "-fa T.mtx",
         "-ff -c .2 .3 .5 -s 2 T.mtx",
@@ -474,11 +479,7 @@ fn chain_without_nrows_matches_stored_dctimestep() {
         &tp(),
         &words("-fa V.vmx T.mtx D.dmx sky_t1_mar21_1000_clear.skv"),
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_ok(&out);
     let nums = |b: &[u8]| -> Vec<f64> {
         let s = String::from_utf8_lossy(b).to_string();
         let p = s.find("\n\n").unwrap() + 2;
@@ -567,11 +568,7 @@ fn oracle_trailing_ops_broadcast_chain_order_division() {
         &dir,
         &words("-fa -E e.err A.mtx * -R F1.rep F1.mtx"),
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_ok(&out);
     let e = std::fs::read_to_string(dir.join("e.err")).unwrap();
     assert!(e.contains("NCOMP=3\n"), "{e}");
     for case in [

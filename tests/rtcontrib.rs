@@ -1286,12 +1286,7 @@ fn picture_output_to_openexr() {
         .args(["-m", "skyglow"])
         .arg(&sky)
         .current_dir(&dir);
-        let out = common::run_stdin(c, &rays);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        common::pipe_ok(c, &rays);
     }
     for bin in 0..2 {
         let hdr = std::fs::read(dir.join(format!("p_{bin}.hdr"))).unwrap();
@@ -1536,12 +1531,7 @@ fn recover_after_killing_a_run() {
             .stderr(std::process::Stdio::piped());
         c
     };
-    let full = feed(&args("full.dat", &[])).output().unwrap();
-    assert!(
-        full.status.success(),
-        "{}",
-        String::from_utf8_lossy(&full.stderr)
-    );
+    common::output_ok(&mut feed(&args("full.dat", &[])));
     let full = std::fs::read(dir.join("full.dat")).unwrap();
     let partial = dir.join(".part.dat.rtcontrib-partial");
     let mut child = feed(&args("part.dat", &[])).spawn().unwrap();

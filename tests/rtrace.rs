@@ -2,25 +2,7 @@
 
 mod common;
 
-use std::io::Write;
-use std::process::{Command, Stdio};
-
-fn run_with_input(mut cmd: Command, input: &[u8]) -> Vec<u8> {
-    let mut child = cmd
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("spawn");
-    child.stdin.take().unwrap().write_all(input).unwrap();
-    let out = child.wait_with_output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out.stdout
-}
+use std::path::{Path, PathBuf};
 
 const SCENE: [&str; 5] = [
     "materials.rad",
@@ -67,7 +49,7 @@ fn ours(seed: u64, n: u32, extra: &[&str]) -> Vec<u8> {
     ]);
     c.args(extra);
     c.args(scene_args());
-    run_with_input(c, &sensors())
+    common::pipe_ok(c, &sensors())
 }
 
 #[test]
@@ -88,7 +70,7 @@ fn header_and_formats() {
     for v in [2.0f32, 2.0, 1.5, 0.0, 0.0, 1.0] {
         input.extend(v.to_ne_bytes());
     }
-    let out = run_with_input(c, &input);
+    let out = common::pipe_ok(c, &input);
     let text = String::from_utf8_lossy(&out);
     assert!(
         text.starts_with("#?RADIANCE\n") && text.contains("FORMAT=float\n"),
@@ -112,26 +94,19 @@ fn header_and_formats() {
 /// with 5 degrees of freedom, failing about once in 120 runs on the dim sensors.)
 #[test]
 fn oracle_rtrace_irradiance_glass_room() {
-    let Some(oracle) = common::oracle() else {
+    let Some((oracle, dir)) = common::cli::oracle_scratch("oracle_rtrace_glass_room") else {
         return;
     };
-    let dir = common::scratch("oracle_rtrace_glass_room");
     let oct = dir.join("scene.oct");
     let mut oc = oracle.command("oconv");
     oc.args(scene_args());
-    let out = oc.output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    std::fs::write(&oct, &out.stdout).unwrap();
+    std::fs::write(&oct, common::run_ok(&mut oc)).unwrap();
     let mut rt = oracle.command("rtrace");
     rt.args([
         "-h", "-I+", "-ab", "3", "-ad", "4096", "-aa", "0", "-lw", "1e-5", "-n", "2",
     ])
     .arg(&oct);
-    let theirs = values(&run_with_input(rt, &sensors()));
+    let theirs = values(&common::pipe_ok(rt, &sensors()));
     let k = 6;
     let runs: Vec<Vec<[f64; 3]>> = (0..k)
         .map(|s| values(&ours(s, 2, &["-ab", "3", "-ad", "4096", "-lw", "1e-5"])))
@@ -141,24 +116,49 @@ fn oracle_rtrace_irradiance_glass_room() {
     ];
     assert_eq!(theirs.len(), ORACLE_SD.len());
     for i in 0..theirs.len() {
-        let xs: Vec<f64> = runs.iter().map(|r| r[i][1]).collect();
-        let mean = xs.iter().sum::<f64>() / k as f64;
-        let var = xs.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (k - 1) as f64;
+        let (mean, var) = green_mean_var(&runs, i);
         let sd = (ORACLE_SD[i].powi(2) + var / k as f64).sqrt();
-        let tol = 4.5 * sd + 0.005 * mean;
-        let diff = theirs[i][1] - mean;
-        eprintln!(
-            "sensor {i}: oracle {:.4} ours {mean:.4} (sd {:.4}) diff {:+.2}%",
-            theirs[i][1],
-            var.sqrt(),
-            100.0 * diff / mean
-        );
-        assert!(
-            diff.abs() <= tol,
-            "sensor {i}: oracle {} vs ours {mean} (tolerance {tol})",
-            theirs[i][1]
-        );
+        check_sensor(i, theirs[i][1], mean, var.sqrt(), 4.5 * sd + 0.005 * mean);
     }
+}
+
+/// Mean and sample variance of sensor `i`'s green value over `runs` (one list of sensor
+/// values per run).
+fn green_mean_var(runs: &[Vec<[f64; 3]>], i: usize) -> (f64, f64) {
+    let n = runs.len() as f64;
+    let xs: Vec<f64> = runs.iter().map(|r| r[i][1]).collect();
+    let mean = xs.iter().sum::<f64>() / n;
+    let var = xs.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, var)
+}
+
+/// Prints sensor `i`'s oracle value `theirs` against our `mean` (whose spread is `sd`) and
+/// asserts that they agree within `tol`.
+fn check_sensor(i: usize, theirs: f64, mean: f64, sd: f64, tol: f64) {
+    let diff = theirs - mean;
+    eprintln!(
+        "sensor {i}: oracle {theirs:.4} ours {mean:.4} (sd {sd:.4}) diff {:+.2}%",
+        100.0 * diff / mean
+    );
+    assert!(
+        diff.abs() <= tol,
+        "sensor {i}: oracle {theirs} vs ours {mean} (tolerance {tol})"
+    );
+}
+
+/// The office of a stored reference case in `dir` with `window` and `sky`: the paths of its
+/// scene files, and the sensor points.
+fn office_case(dir: &Path, window: &str, sky: &str) -> (Vec<PathBuf>, Vec<u8>) {
+    let files = [
+        "materials.rad",
+        "room.rad",
+        "exterior.rad",
+        window,
+        sky,
+        "skyfunc_glow.rad",
+    ];
+    let input = std::fs::read(dir.join("sensors.pts")).unwrap();
+    (files.iter().map(|f| dir.join(f)).collect(), input)
 }
 
 /// Agreement with the stored oracle output `irr_glass_noproxy.dat` (reference case mkillum:
@@ -173,15 +173,7 @@ fn oracle_rtrace_irradiance_glass_room() {
 #[test]
 fn reference_mkillum_glass_irradiance() {
     let dir = common::fixture("rtrace_mkillum_glass");
-    let files = [
-        "materials.rad",
-        "room.rad",
-        "exterior.rad",
-        "window_glass.rad",
-        "sky.rad",
-        "skyfunc_glow.rad",
-    ];
-    let input = std::fs::read(dir.join("sensors.pts")).unwrap();
+    let (files, input) = office_case(&dir, "window_glass.rad", "sky.rad");
     let theirs = values(&std::fs::read(dir.join("irr_glass_noproxy.dat")).unwrap());
     let k = 5;
     let runs: Vec<Vec<[f64; 3]>> = (0..k)
@@ -203,16 +195,14 @@ fn reference_mkillum_glass_irradiance() {
                 "-seed",
                 &seed.to_string(),
             ]);
-            c.args(files.iter().map(|f| dir.join(f)));
-            values(&run_with_input(c, &input))
+            c.args(&files);
+            values(&common::pipe_ok(c, &input))
         })
         .collect();
     let (mut sum_o, mut sum_f) = (0.0, 0.0);
     let stats: Vec<(f64, f64)> = (0..theirs.len())
         .map(|i| {
-            let xs: Vec<f64> = runs.iter().map(|r| r[i][1]).collect();
-            let mean = xs.iter().sum::<f64>() / k as f64;
-            let var = xs.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (k - 1) as f64;
+            let (mean, var) = green_mean_var(&runs, i);
             (mean, var.sqrt())
         })
         .collect();
@@ -225,19 +215,7 @@ fn reference_mkillum_glass_irradiance() {
         let (mean, s) = stats[i];
         let var = s.max(med_rel * mean).powi(2);
         let sd = var.sqrt() * (1.0 + 1.0 / k as f64).sqrt();
-        let tol = 4.5 * sd + 0.005 * mean;
-        let diff = theirs[i][1] - mean;
-        eprintln!(
-            "sensor {i}: oracle {:.4} ours {mean:.4} (sd {:.4}) diff {:+.2}%",
-            theirs[i][1],
-            var.sqrt(),
-            100.0 * diff / mean
-        );
-        assert!(
-            diff.abs() <= tol,
-            "sensor {i}: oracle {} vs ours {mean} (tolerance {tol})",
-            theirs[i][1]
-        );
+        check_sensor(i, theirs[i][1], mean, var.sqrt(), 4.5 * sd + 0.005 * mean);
         sum_o += theirs[i][1];
         sum_f += mean;
     }
@@ -255,16 +233,9 @@ fn run_scene(text: &str, input: &str, extra: &[&str]) -> std::process::Output {
     std::fs::write(&f, text).unwrap();
     let mut c = common::fenestra("rtrace");
     c.args(["-h"]).args(extra).arg(&f);
-    let mut child = c
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
     // The tool may reject the scene and exit before reading its input: a
-    // broken pipe here is expected then, and the exit status tells the rest.
-    let _ = child.stdin.take().unwrap().write_all(input.as_bytes());
-    child.wait_with_output().unwrap()
+    // broken pipe is expected then (run_stdin ignores it), and the exit status tells the rest.
+    common::run_stdin(c, input.as_bytes())
 }
 
 #[test]
@@ -334,23 +305,15 @@ fn concave_polygon_shadow() {
 #[test]
 fn reference_threephase_bsdf_overcast() {
     let dir = common::fixture("rtrace_threephase_bsdf");
-    let files = [
-        "materials.rad",
-        "room.rad",
-        "exterior.rad",
-        "window_bsdf.rad",
-        "sky_t4_sep21_1200_overcast.rad",
-        "skyfunc_glow.rad",
-    ];
-    let input = std::fs::read(dir.join("sensors.pts")).unwrap();
+    let (files, input) = office_case(&dir, "window_bsdf.rad", "sky_t4_sep21_1200_overcast.rad");
     let theirs = values(&std::fs::read(dir.join("ref_t4_sep21_1200_overcast.dat")).unwrap());
     let mut c = common::fenestra("rtrace");
     c.env("RAYPATH", common::fixture("threephase"));
     c.args([
         "-h", "-I+", "-ab", "6", "-ad", "16384", "-aa", "0", "-lw", "1e-5", "-n", "2",
     ]);
-    c.args(files.iter().map(|f| dir.join(f)));
-    let ours = values(&run_with_input(c, &input));
+    c.args(files);
+    let ours = values(&common::pipe_ok(c, &input));
     assert_eq!(ours.len(), theirs.len());
     let (mut so, mut sf) = (0.0, 0.0);
     for (i, (o, f)) in theirs.iter().zip(&ours).enumerate() {
@@ -375,35 +338,38 @@ fn defaults_version_and_warnings_as_radiance() {
     let out =
         common::run_ok(common::fenestra("rtrace").args(["-ab", "3", "-ss", "0.5", "-defaults"]));
     let text = String::from_utf8_lossy(&out);
-    assert!(text.contains("-ab 3 "), "{text}");
-    assert!(text.contains("-ss 0.500000"), "{text}");
+    common::cli::assert_contains(&text, &["-ab 3 ", "-ss 0.500000"]);
     assert!(text.lines().count() > 20);
     let out = common::run_ok(common::fenestra("rtrace").arg("-version"));
     assert!(String::from_utf8_lossy(&out).starts_with("fenestra "));
-    std::fs::write(
-        dir.join("sky.rad"),
+    // one upward ray in the scene file `name` holding `text`
+    let run = |name: &str, text: &str| {
+        std::fs::write(dir.join(name), text).unwrap();
+        let mut c = common::fenestra("rtrace");
+        c.args(["-h", name]).current_dir(&dir);
+        common::run_stdin(c, b"0 0 0 0 0 1\n")
+    };
+    let o = run(
+        "sky.rad",
         "void glow g\n0\n0\n4 1 1 1 0\ng source s\n0\n0\n4 0 0 1 180\n",
-    )
-    .unwrap();
-    let mut c = common::fenestra("rtrace");
-    c.args(["-h", "sky.rad"]).current_dir(&dir);
-    let o = common::run_stdin(c, b"0 0 0 0 0 1\n");
+    );
     assert!(o.status.success());
     assert_eq!(
         String::from_utf8_lossy(&o.stderr),
         "",
         "a sky-only scene warned"
     );
-    std::fs::write(
-        dir.join("dark.rad"),
+    let o = run(
+        "dark.rad",
         "void plastic m\n0\n0\n5 .5 .5 .5 0 0\nm sphere b\n0\n0\n4 0 0 5 1\n",
-    )
-    .unwrap();
-    let mut c = common::fenestra("rtrace");
-    c.args(["-h", "dark.rad"]).current_dir(&dir);
-    let o = common::run_stdin(c, b"0 0 0 0 0 1\n");
+    );
     assert!(String::from_utf8_lossy(&o.stderr).contains("no light sources found"));
 }
+
+/// A uniform glow of radiance 1 over the whole sky and the whole ground.
+const GLOW_SKY_AND_GROUND: &str =
+    "void glow skyglow\n0\n0\n4 1 1 1 0\nskyglow source sky\n0\n0\n4 0 0 1 180\n\
+     skyglow source ground\n0\n0\n4 0 0 -1 180\n";
 
 /// A rough specular lobe too weak to sample (not above `-st`, default 0.15) joins its side's
 /// ambient coefficient, as in Radiance: plastic (spec .02, rough .05), metal (spec .1, rough
@@ -414,16 +380,17 @@ fn defaults_version_and_warnings_as_radiance() {
 /// Radiance's 0.608 in red).
 #[test]
 fn oracle_weak_rough_lobes_join_the_ambient() {
-    let Some(o) = common::oracle() else { return };
-    let dir = common::scratch("rtrace-weak-lobes");
-    let scene = "void glow skyglow\n0\n0\n4 1 1 1 0\nskyglow source sky\n0\n0\n4 0 0 1 180\n\
-        skyglow source ground\n0\n0\n4 0 0 -1 180\n\
-        void plastic pl\n0\n0\n5 .6 .55 .5 .02 .05\n\
+    let Some((o, dir)) = common::cli::oracle_scratch("rtrace-weak-lobes") else {
+        return;
+    };
+    let scene = format!(
+        "{GLOW_SKY_AND_GROUND}void plastic pl\n0\n0\n5 .6 .55 .5 .02 .05\n\
         pl polygon f1\n0\n0\n12 -100 -100 0 -1 -100 0 -1 100 0 -100 100 0\n\
         void metal me\n0\n0\n5 .6 .55 .5 .1 .1\n\
         me polygon f2\n0\n0\n12 1 -100 0 100 -100 0 100 100 0 1 100 0\n\
         void trans tr\n0\n0\n7 .6 .55 .5 .03 .08 .5 .1\n\
-        tr polygon f3\n0\n0\n12 -1 -100 0 1 -100 0 1 100 0 -1 100 0\n";
+        tr polygon f3\n0\n0\n12 -1 -100 0 1 -100 0 1 100 0 -1 100 0\n"
+    );
     std::fs::write(dir.join("scene.rad"), scene).unwrap();
     // down onto each panel (reflection), and up at the trans panel from below (transmission
     // and reflection of the lower side)
@@ -442,14 +409,15 @@ fn oracle_weak_rough_lobes_join_the_ambient() {
 /// each ray.
 #[test]
 fn oracle_rough_specular_lobes_are_sampled() {
-    let Some(o) = common::oracle() else { return };
-    let dir = common::scratch("rtrace-rough-lobes");
-    let scene = "void glow skyglow\n0\n0\n4 1 1 1 0\nskyglow source sky\n0\n0\n4 0 0 1 180\n\
-        skyglow source ground\n0\n0\n4 0 0 -1 180\n\
-        void trans tr\n0\n0\n7 .6 .55 .5 0 .1 .5 .5\n\
+    let Some((o, dir)) = common::cli::oracle_scratch("rtrace-rough-lobes") else {
+        return;
+    };
+    let scene = format!(
+        "{GLOW_SKY_AND_GROUND}void trans tr\n0\n0\n7 .6 .55 .5 0 .1 .5 .5\n\
         tr polygon panel\n0\n0\n12 -100 -100 0 100 -100 0 100 100 0 -100 100 0\n\
         void plastic pl\n0\n0\n5 .6 .55 .5 .3 .1\n\
-        pl polygon floor\n0\n0\n12 -100 -100 -5 100 -100 -5 100 100 -5 -100 100 -5\n";
+        pl polygon floor\n0\n0\n12 -100 -100 -5 100 -100 -5 100 100 -5 -100 100 -5\n"
+    );
     std::fs::write(dir.join("scene.rad"), scene).unwrap();
     let kinds = ["0 0 1 0 0 -1\n", "0 0 -1 0 0 1\n", "0 0 -4 0 0 -1\n"];
     let rays: String = kinds

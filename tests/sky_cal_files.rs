@@ -6,9 +6,7 @@ mod common;
 
 use fenestra_sky::cie::SkyBright;
 use fenestra_sky::skyvec::PerezLum;
-use std::io::Write;
 use std::path::Path;
-use std::process::Stdio;
 
 /// Directions over the whole sphere, plus the horizon, the ±0.01 switch of the
 /// horizon factor, zenith and nadir.
@@ -35,30 +33,18 @@ fn rcalc(o: &common::Oracle, cal: &Path, args: &[f64], func: &str) -> Vec<f64> {
     for (i, a) in args.iter().enumerate() {
         defs += &format!("A{}={a:e};", i + 1);
     }
-    let mut c = o
-        .command("rcalc")
-        .arg("-od")
+    let mut c = o.command("rcalc");
+    c.arg("-od")
         .arg("-f")
         .arg(o.lib().join("rayinit.cal"))
         .args(["-e", &defs, "-f"])
         .arg(cal)
-        .args(["-e", &format!("$1={func}")])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
+        .args(["-e", &format!("$1={func}")]);
     let mut input = String::new();
     for d in directions() {
         input += &format!("{:e} {:e} {:e}\n", d[0], d[1], d[2]);
     }
-    c.stdin.take().unwrap().write_all(input.as_bytes()).unwrap();
-    let out = c.wait_with_output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out.stdout
+    common::pipe_ok(c, input.as_bytes())
         .chunks(8)
         .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
         .collect()
@@ -70,23 +56,17 @@ fn close(a: f64, b: f64) -> bool {
     (a - b).abs() <= 1e-12 * a.abs().max(b.abs()).max(1e-300)
 }
 
-#[test]
-fn oracle_skybright_cal() {
+/// For each of `skies` (a sky function's arguments), `func` of fenestra's lib/`file` and of
+/// Radiance's, both evaluated by the oracle's rcalc, and the Rust model's radiance
+/// `model(sky, direction)` must agree over [`directions`]. Skipped without the oracle.
+fn check_cal(file: &str, func: &str, skies: &[&[f64]], model: impl Fn(&[f64], [f64; 3]) -> f64) {
     let Some(o) = common::oracle() else { return };
-    let ours = common::fixture("../../lib/skybright.cal");
-    let theirs = o.lib().join("skybright.cal");
-    let skies: &[&[f64]] = &[
-        &[1.0, 11.61, 23.77, 0.6942, 0.070810, -0.615688, 0.784802],
-        &[4.0, 9.5, 12.1, 1.022, -0.4, 0.3, 0.866],
-        &[2.0, 25.54, 3.973],
-        &[3.0, 20.0, 4.0],
-        &[1.0, 3.6, 4.8, 0.3045, -0.045, -0.97294, 0.226623],
-    ];
+    let ours = common::fixture(&format!("../../lib/{file}"));
+    let theirs = o.lib().join(file);
     let dirs = directions();
-    for a in skies {
-        let x = rcalc(&o, &ours, a, "skybr");
-        let y = rcalc(&o, &theirs, a, "skybr");
-        let m = SkyBright::from_args(a).unwrap();
+    for &a in skies {
+        let x = rcalc(&o, &ours, a, func);
+        let y = rcalc(&o, &theirs, a, func);
         for (k, d) in dirs.iter().enumerate() {
             assert!(
                 close(x[k], y[k]),
@@ -94,17 +74,28 @@ fn oracle_skybright_cal() {
                 x[k],
                 y[k]
             );
-            let r = m.radiance(*d);
+            let r = model(a, *d);
             assert!(close(r, y[k]), "{a:?} {d:?}: Rust {r} Radiance {}", y[k]);
         }
     }
 }
 
 #[test]
+fn oracle_skybright_cal() {
+    let skies: &[&[f64]] = &[
+        &[1.0, 11.61, 23.77, 0.6942, 0.070810, -0.615688, 0.784802],
+        &[4.0, 9.5, 12.1, 1.022, -0.4, 0.3, 0.866],
+        &[2.0, 25.54, 3.973],
+        &[3.0, 20.0, 4.0],
+        &[1.0, 3.6, 4.8, 0.3045, -0.045, -0.97294, 0.226623],
+    ];
+    check_cal("skybright.cal", "skybr", skies, |a, d| {
+        SkyBright::from_args(a).unwrap().radiance(d)
+    });
+}
+
+#[test]
 fn oracle_perezlum_cal() {
-    let Some(o) = common::oracle() else { return };
-    let ours = common::fixture("../../lib/perezlum.cal");
-    let theirs = o.lib().join("perezlum.cal");
     let skies: &[&[f64]] = &[
         &[
             37.58, 27.17, -0.969191, -0.175739, 20.531681, -5.689187, 1.276820, 0.070635,
@@ -119,15 +110,7 @@ fn oracle_perezlum_cal() {
             -0.770308, 0.139489,
         ],
     ];
-    let dirs = directions();
-    for a in skies {
-        let x = rcalc(&o, &ours, a, "skybright");
-        let y = rcalc(&o, &theirs, a, "skybright");
-        let m = PerezLum::from_args(a).unwrap();
-        for (k, d) in dirs.iter().enumerate() {
-            assert!(close(x[k], y[k]), "{d:?}: ours {} Radiance {}", x[k], y[k]);
-            let r = m.radiance(*d);
-            assert!(close(r, y[k]), "{d:?}: Rust {r} Radiance {}", y[k]);
-        }
-    }
+    check_cal("perezlum.cal", "skybright", skies, |a, d| {
+        PerezLum::from_args(a).unwrap().radiance(d)
+    });
 }

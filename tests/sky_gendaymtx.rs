@@ -4,6 +4,7 @@
 mod common;
 
 use std::path::Path;
+use std::process::Command;
 
 /// Header lines after the command line, then the data, as text.
 fn body(text: &str) -> Vec<&str> {
@@ -96,35 +97,49 @@ fn malformed_line_is_reported_with_its_number() {
     assert!(err.contains("line 10"), "{err}");
 }
 
-#[test]
-fn oracle_gendaymtx_generated_cases() {
+/// For each of `cases`, when the oracle is present: the oracle's gendaymtx and ours, each with
+/// the case's arguments in the sky fixtures, handed to `check` (arguments, theirs, ours).
+fn oracle_cases(cases: &[&[&str]], check: impl Fn(&[&str], Command, Command)) {
     let Some(o) = common::oracle() else { return };
     let dir = common::fixture("sky");
-    let cases: &[&[&str]] = &[
-        &["-m", "2", "test.wea"],
-        &["-m", "4", "-of", "test.wea"],
-        &["-m", "1", "-O1", "two_days.wea"],
-        &[
-            "-m",
-            "2",
-            "-r",
-            "30",
-            "-g",
-            ".1",
-            ".2",
-            ".3",
-            "two_days.wea",
-        ],
-        &["-A", "-m", "1", "test.wea"],
-        &["-u", "-m", "1", "two_days.wea"],
-        &["-5", ".533", "-m", "1", "test.wea"],
-        &["-h", "-od", "-m", "1", "test.wea"],
-        &["-i", "60", "-m", "1", "test.wea"],
-        &["-D", "-", "test.wea"],
-    ];
-    for args in cases {
-        let want = common::run_ok(o.command("gendaymtx").args(*args).current_dir(&dir));
-        let got = ours(args, &dir);
+    for &args in cases {
+        let mut oracle_cmd = o.command("gendaymtx");
+        oracle_cmd.args(args).current_dir(&dir);
+        let mut our_cmd = common::fenestra("gendaymtx");
+        our_cmd.args(args).current_dir(&dir);
+        check(args, oracle_cmd, our_cmd);
+    }
+}
+
+/// Options on the .wea fixtures.
+const GENERATED_CASES: &[&[&str]] = &[
+    &["-m", "2", "test.wea"],
+    &["-m", "4", "-of", "test.wea"],
+    &["-m", "1", "-O1", "two_days.wea"],
+    &[
+        "-m",
+        "2",
+        "-r",
+        "30",
+        "-g",
+        ".1",
+        ".2",
+        ".3",
+        "two_days.wea",
+    ],
+    &["-A", "-m", "1", "test.wea"],
+    &["-u", "-m", "1", "two_days.wea"],
+    &["-5", ".533", "-m", "1", "test.wea"],
+    &["-h", "-od", "-m", "1", "test.wea"],
+    &["-i", "60", "-m", "1", "test.wea"],
+    &["-D", "-", "test.wea"],
+];
+
+#[test]
+fn oracle_gendaymtx_generated_cases() {
+    oracle_cases(GENERATED_CASES, |args, mut oracle_cmd, mut our_cmd| {
+        let want = common::run_ok(&mut oracle_cmd);
+        let got = common::run_ok(&mut our_cmd);
         let what = args.join(" ");
         if args.contains(&"-of") || args.contains(&"-od") {
             if args.contains(&"-od") {
@@ -141,37 +156,28 @@ fn oracle_gendaymtx_generated_cases() {
         } else {
             assert_same_ascii(&got, &want, &what);
         }
-    }
+    });
 }
+
+/// EPW tapes (fixed and varying dew point) and hard .wea tapes (tropic, polar).
+const EPW_AND_HARD_CASES: &[&[&str]] = &[
+    &["-m", "1", "two_days_dew11.epw"],
+    &["-m", "2", "-of", "two_days_dewvar.epw"],
+    &["-m", "1", "-O1", "two_days_dewvar.epw"],
+    &["-m", "1", "hard_tropic.wea"],
+    &["-m", "2", "-of", "hard_tropic.wea"],
+    &["-m", "1", "-u", "hard_tropic.wea"],
+    &["-m", "1", "-A", "hard_tropic.wea"],
+    &["-m", "1", "hard_polar.wea"],
+    &["-m", "2", "-of", "hard_polar.wea"],
+    &["-m", "1", "-u", "-d", "hard_polar.wea"],
+];
 
 #[test]
 fn oracle_gendaymtx_epw_and_hard_cases() {
-    let Some(o) = common::oracle() else { return };
-    let dir = common::fixture("sky");
-    let cases: &[&[&str]] = &[
-        &["-m", "1", "two_days_dew11.epw"],
-        &["-m", "2", "-of", "two_days_dewvar.epw"],
-        &["-m", "1", "-O1", "two_days_dewvar.epw"],
-        &["-m", "1", "hard_tropic.wea"],
-        &["-m", "2", "-of", "hard_tropic.wea"],
-        &["-m", "1", "-u", "hard_tropic.wea"],
-        &["-m", "1", "-A", "hard_tropic.wea"],
-        &["-m", "1", "hard_polar.wea"],
-        &["-m", "2", "-of", "hard_polar.wea"],
-        &["-m", "1", "-u", "-d", "hard_polar.wea"],
-    ];
-    for args in cases {
-        let want = o
-            .command("gendaymtx")
-            .args(*args)
-            .current_dir(&dir)
-            .output()
-            .unwrap();
-        let got = common::fenestra("gendaymtx")
-            .args(*args)
-            .current_dir(&dir)
-            .output()
-            .unwrap();
+    oracle_cases(EPW_AND_HARD_CASES, |args, mut oracle_cmd, mut our_cmd| {
+        let want = oracle_cmd.output().unwrap();
+        let got = our_cmd.output().unwrap();
         let what = args.join(" ");
         assert!(got.status.success(), "{what}");
         if args.contains(&"-of") {
@@ -187,7 +193,7 @@ fn oracle_gendaymtx_epw_and_hard_cases() {
                 .collect()
         };
         assert_eq!(strip(&got.stderr), strip(&want.stderr), "{what}: warnings");
-    }
+    });
 }
 
 /// An EPW whose dew point is 11 °C (the .wea's fixed value) gives the .wea's matrix.

@@ -3,7 +3,6 @@
 
 mod common;
 
-use std::io::Write;
 use std::process::Stdio;
 
 fn rows(text: &str) -> Vec<[f64; 3]> {
@@ -19,20 +18,9 @@ fn rows(text: &str) -> Vec<[f64; 3]> {
 }
 
 fn genskyvec(args: &[&str], sky: &[u8]) -> String {
-    let mut c = common::fenestra("genskyvec")
-        .args(args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    c.stdin.take().unwrap().write_all(sky).unwrap();
-    let out = c.wait_with_output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).unwrap()
+    let mut c = common::fenestra("genskyvec");
+    c.args(args);
+    String::from_utf8(common::pipe_ok(c, sky)).unwrap()
 }
 
 /// Relative agreement required: each sample passes through single precision
@@ -162,17 +150,8 @@ fn bad_descriptions_fail() {
         .output()
         .unwrap();
     assert!(!out.status.success());
-    let mut c = common::fenestra("genskyvec")
-        .stdin(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    c.stdin
-        .take()
-        .unwrap()
-        .write_all(b"void plastic x 0 0 5 1 1 1 0 0\n")
-        .unwrap();
-    let out = c.wait_with_output().unwrap();
+    let c = common::fenestra("genskyvec");
+    let out = common::run_stdin(c, b"void plastic x 0 0 5 1 1 1 0 0\n");
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("Bad sky description"));
 }
@@ -233,23 +212,12 @@ fn user_sky_function_through_the_cal_engine() {
     let renamed = sky.replace("skybright.cal", "mysky.cal");
     assert_ne!(renamed, sky);
     let run = |text: &str| {
-        let mut c = common::fenestra("genskyvec")
-            .args(["-m", "1"])
-            .current_dir(&dir)
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        c.stdin.take().unwrap().write_all(text.as_bytes()).unwrap();
-        c.wait_with_output().unwrap()
+        let mut c = common::fenestra("genskyvec");
+        c.args(["-m", "1"]).current_dir(&dir);
+        common::run_stdin(c, text.as_bytes())
     };
     let out = run(&renamed);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_ok(&out);
     let via_cal = rows(&String::from_utf8_lossy(&out.stdout));
     // Same samples, same single-precision rounding of the pattern value: the native model
     // and the .cal file agree to 1e-12 before rounding, so rows agree to f32 rounding.
@@ -258,11 +226,7 @@ fn user_sky_function_through_the_cal_engine() {
     // A user's sky: radiance 1 + Dz (no sun): patch means of 1 + Dz times the sky colour.
     std::fs::write(dir.join("lin.cal"), "linsky = A1 + A2*Dz;\n").unwrap();
     let out = run("void brightfunc skyfunc 2 linsky lin.cal 0 2 1 1\nskyfunc glow skyglow 0 0 4 1 1 1 0\nskyglow source sky 0 0 4 0 0 1 180\n");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_ok(&out);
     let v = rows(&String::from_utf8_lossy(&out.stdout));
     assert_eq!(v.len(), 146);
     // Zenith patch (last): Dz close to 1; horizon rows: Dz small; ground row (0): 1 + Dz < 1.

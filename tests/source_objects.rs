@@ -71,10 +71,9 @@ fn check(what: &str, theirs: &[f64], ours: &[f64], min_lit: usize) -> f64 {
 
 #[test]
 fn oracle_same_material_sources_block_each_other() {
-    let Some(oracle) = common::oracle() else {
+    let Some((oracle, dir)) = common::cli::oracle_scratch("source_objects") else {
         return;
     };
-    let dir = common::scratch("source_objects");
     std::fs::write(dir.join("scene.rad"), SAME).unwrap();
     let input = rays(
         &[-2.5, -2.0, -1.5, -0.5, 0.0, 0.4, 1.0, 2.0, 2.5, 2.8],
@@ -89,29 +88,11 @@ fn oracle_same_material_sources_block_each_other() {
     check("rtrace", &t, &o, 30);
     // rcontrib: contributions of each material (-V+), no jitter so that both sample the
     // same points
-    let mut c = oracle.command("oconv");
-    c.arg("scene.rad").current_dir(&dir);
-    std::fs::write(dir.join("scene.oct"), common::run_ok(&mut c)).unwrap();
+    common::oracle_octree(&oracle, &dir, &["scene.rad"]);
     let ropts = [
         "-h", "-V+", "-ab", "0", "-ds", "0", "-dj", "0", "-m", "lm", "-m", "sunm",
     ];
-    let mut theirs = oracle.command("rcontrib");
-    theirs.args(ropts).arg("scene.oct").current_dir(&dir);
-    let tt = common::run_stdin(theirs, input.as_bytes());
-    assert!(
-        tt.status.success(),
-        "{}",
-        String::from_utf8_lossy(&tt.stderr)
-    );
-    let mut ours = common::fenestra("rcontrib");
-    ours.args(ropts).arg("scene.rad").current_dir(&dir);
-    let oo = common::run_stdin(ours, input.as_bytes());
-    assert!(
-        oo.status.success(),
-        "{}",
-        String::from_utf8_lossy(&oo.stderr)
-    );
-    let (tt, oo) = (common::numbers(&tt.stdout), common::numbers(&oo.stdout));
+    let (tt, oo) = common::cli::both_numbers(&oracle, "rcontrib", &dir, &ropts, input.as_bytes());
     // both materials light every point (measured: 180 of 180)
     check("rcontrib -m lm -m sunm", &tt, &oo, 180);
     // Under the small square the lamps' light is the small lamp's: 10 x its solid angle
@@ -129,10 +110,9 @@ fn oracle_same_material_sources_block_each_other() {
 
 #[test]
 fn oracle_illum_in_front_of_illum_or_glow_blocks() {
-    let Some(oracle) = common::oracle() else {
+    let Some((oracle, dir)) = common::cli::oracle_scratch("source_objects_illum") else {
         return;
     };
-    let dir = common::scratch("source_objects_illum");
     std::fs::write(dir.join("scene.rad"), ILLUM).unwrap();
     let input = rays(&[-1.5, -0.5, 0.0, 0.2, 1.2, 3.5, 4.2], &[0.0, 0.7]);
     let opts = ["-h", "-ab", "0", "-ds", "0", "-dt", "0"];

@@ -6,8 +6,6 @@
 
 mod common;
 
-use std::process::Command;
-
 /// A large plate of `material` (named M) under a uniform glow sky of radiance 1.
 fn plate(material: &str) -> String {
     format!(
@@ -29,9 +27,8 @@ fn mean_red(v: &[f64]) -> f64 {
 }
 
 fn ours_rtrace(dir: &std::path::Path, opts: &[&str], rays: &str) -> Vec<f64> {
-    let mut c: Command = common::fenestra("rtrace");
-    c.args(opts).arg("scene.rad").current_dir(dir);
-    common::numbers(&common::run_stdin_ok(c, rays.as_bytes()).stdout)
+    let rtrace = common::fenestra("rtrace");
+    common::cli::scene_numbers(rtrace, dir, opts, "scene.rad", rays.as_bytes())
 }
 
 /// Without the oracle: a rough metal plate under a uniform sky reflects its whole specular
@@ -67,32 +64,21 @@ fn rough_lobe_keeps_its_energy_at_grazing_angles() {
 /// programs' means 0.57%) and is held to 2.5% (4.4 sd); at normal incidence 0.5% (5 sd).
 #[test]
 fn oracle_rough_specular_lobes() {
-    let Some(oracle) = common::oracle() else {
+    let Some((oracle, dir)) = common::cli::oracle_scratch("spec_lobes") else {
         return;
     };
-    let dir = common::scratch("spec_lobes");
     let metal = "void metal M 0 0 5 .8 .8 .8 .9 .25";
+    let plastic = "void plastic M 0 0 5 .5 .5 .5 .2 .25";
+    let trans = "void trans M 0 0 7 .8 .8 .8 0 .25 .9 1";
     let cases: [(&str, f64, &str, f64, usize); 8] = [
         (metal, 2.0, "1", 0.003, 2000),
         (metal, 10.0, "1", 0.003, 2000),
-        (
-            "void plastic M 0 0 5 .5 .5 .5 .2 .25",
-            2.0,
-            "1",
-            0.003,
-            2000,
-        ),
+        (plastic, 2.0, "1", 0.003, 2000),
         (metal, 2.0, "0", 0.003, 2000),
         (metal, 2.0, "0.5", 0.003, 2000),
         (metal, 2.0, "4", 0.025, 8000),
         (metal, 90.0, "4", 0.005, 2000),
-        (
-            "void trans M 0 0 7 .8 .8 .8 0 .25 .9 1",
-            2.0,
-            "1",
-            0.003,
-            2000,
-        ),
+        (trans, 2.0, "1", 0.003, 2000),
     ];
     for (mat, elev, ss, tol, n) in cases {
         std::fs::write(dir.join("scene.rad"), plate(mat)).unwrap();
@@ -119,10 +105,9 @@ fn oracle_rough_specular_lobes() {
 /// same digits as the oracle's.
 #[test]
 fn oracle_reflection_level_and_fresnel() {
-    let Some(oracle) = common::oracle() else {
+    let Some((oracle, dir)) = common::cli::oracle_scratch("spec_lr") else {
         return;
     };
-    let dir = common::scratch("spec_lr");
     let mut scene =
         String::from("void glass G 0 0 3 .9 .9 .9\nvoid trans T 0 0 7 .8 .8 .8 0 0 .9 1\n");
     for z in 1..=3 {
@@ -156,10 +141,9 @@ fn oracle_reflection_level_and_fresnel() {
 /// were lost before. Deterministic (`-dj 0`): print precision.
 #[test]
 fn oracle_small_coefficient_sun_contributions() {
-    let Some(oracle) = common::oracle() else {
+    let Some((oracle, dir)) = common::cli::oracle_scratch("spec_vplus") else {
         return;
     };
-    let dir = common::scratch("spec_vplus");
     for (alt, rho) in [("25", ".1"), ("5", ".05"), ("0.8", ".1")] {
         let mut g = oracle.command("gensky");
         g.args(["-ang", alt, "-46", "+s"]);
@@ -168,17 +152,11 @@ fn oracle_small_coefficient_sun_contributions() {
             "void plastic g 0 0 5 {rho} {rho} {rho} 0 0\ng polygon gr 0 0 12 -50 -50 0 50 -50 0 50 50 0 -50 50 0\n"
         );
         std::fs::write(dir.join("scene.rad"), sky + &ground).unwrap();
-        let mut c = oracle.command("oconv");
-        c.arg("scene.rad").current_dir(&dir);
-        std::fs::write(dir.join("scene.oct"), common::run_ok(&mut c)).unwrap();
+        common::oracle_octree(&oracle, &dir, &["scene.rad"]);
         for v in ["-V+", "-V-"] {
             let args = ["-h", v, "-ab", "0", "-dj", "0", "-m", "solar"];
-            let mut theirs = oracle.command("rcontrib");
-            theirs.args(args).arg("scene.oct").current_dir(&dir);
-            let mut ours = common::fenestra("rcontrib");
-            ours.args(args).arg("scene.rad").current_dir(&dir);
-            let t = common::numbers(&common::run_stdin_ok(theirs, b"5 5 1 0 0 -1\n").stdout);
-            let o = common::numbers(&common::run_stdin_ok(ours, b"5 5 1 0 0 -1\n").stdout);
+            let (t, o) =
+                common::cli::both_numbers(&oracle, "rcontrib", &dir, &args, b"5 5 1 0 0 -1\n");
             if v == "-V+" {
                 assert!(t[0] > 0.01, "sun at {alt}°: the oracle's value {t:?}");
             }

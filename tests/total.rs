@@ -2,50 +2,25 @@
 
 mod common;
 
-use std::io::Write;
+use common::Lcg;
 use std::path::Path;
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Output};
 
 fn words(s: &str) -> Vec<String> {
     s.split_whitespace().map(str::to_string).collect()
 }
 
 fn run(mut c: Command, dir: &Path, args: &[String], stdin: &[u8]) -> Output {
-    c.current_dir(dir)
-        .args(args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped());
-    let mut child = c
-        .spawn()
-        .unwrap_or_else(|e| panic!("cannot run {c:?}: {e}"));
-    let mut input = child.stdin.take().unwrap();
-    let data = stdin.to_vec();
-    let writer = std::thread::spawn(move || {
-        let _ = input.write_all(&data);
-    });
-    let out = child.wait_with_output().unwrap();
-    writer.join().unwrap();
-    out
+    c.current_dir(dir).args(args);
+    common::run_stdin(c, stdin)
 }
 
-/// A small deterministic generator (64-bit LCG).
-struct Lcg(u64);
-
-impl Lcg {
-    fn next(&mut self) -> u64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        self.0 >> 33
-    }
-    fn real(&mut self) -> f64 {
-        let m = (self.next() % 1_000_000) as f64 / 1000.0;
-        let e = [1e-30, 1e-6, 1e-3, 1.0, 1.0, 1.0, 1e3, 1e12][(self.next() % 8) as usize];
-        let s = if self.next() % 4 == 0 { -1.0 } else { 1.0 };
-        s * m * e
-    }
+/// A number of any magnitude and sign from `g`.
+fn real(g: &mut Lcg) -> f64 {
+    let m = (g.bits() % 1_000_000) as f64 / 1000.0;
+    let e = [1e-30, 1e-6, 1e-3, 1.0, 1.0, 1.0, 1e3, 1e12][(g.bits() % 8) as usize];
+    let s = if g.bits() % 4 == 0 { -1.0 } else { 1.0 };
+    s * m * e
 }
 
 /// Random text tables: numbers of every magnitude and sign written in several styles,
@@ -62,11 +37,11 @@ fn oracle_random_text_inputs_are_identical() {
         if case == 5 {
             s.push_str("#?RADIANCE\nNCOLS=3\n\n");
         }
-        let rows = 1 + g.next() % 40;
+        let rows = 1 + g.bits() % 40;
         for r in 0..rows {
-            let ncol = if case >= 3 { 1 + g.next() % 5 } else { 3 };
+            let ncol = if case >= 3 { 1 + g.bits() % 5 } else { 3 };
             for c in 0..ncol {
-                let v = g.real();
+                let v = real(&mut g);
                 let w = match (r + c) % 4 {
                     0 => format!("{v}"),
                     1 => format!("{v:e}"),
@@ -113,7 +88,7 @@ fn oracle_binary_inputs_are_identical() {
     let Some(o) = common::oracle() else { return };
     let dir = common::scratch("total-bin");
     let mut g = Lcg(777);
-    let vals: Vec<f64> = (0..60).map(|_| g.real()).collect();
+    let vals: Vec<f64> = (0..60).map(|_| real(&mut g)).collect();
     let f: Vec<u8> = vals
         .iter()
         .flat_map(|v| (*v as f32).to_ne_bytes())

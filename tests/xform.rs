@@ -84,13 +84,11 @@ fn header_names_the_command_and_stdin_works() {
 
 #[test]
 fn bad_input_is_one_clear_error() {
-    let d = common::scratch("xform-bad");
-    let f = d.join("bad.rad");
-    std::fs::write(
-        &f,
+    let f = common::cli::scratch_file(
+        "xform-bad",
+        "bad.rad",
         "void plastic m 0 0 5 1 1 1 0 0\n\nm polygon p 0 0 7 0 0 0 1 0 0 1\n",
-    )
-    .unwrap();
+    );
     let out = Command::new(common::fenestra("xform").get_program())
         .arg("-t")
         .arg("1")

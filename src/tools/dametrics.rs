@@ -7,7 +7,7 @@ use std::io::Write;
 use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
-use fenestra_cli::opts::{Item, Kind, Opt, Spec};
+use fenestra_cli::opts::{Kind, Opt, Spec};
 use fenestra_dc::metrics::{self, SensorMetrics, Thresholds};
 use fenestra_dc::metrics_input;
 
@@ -17,35 +17,53 @@ fn spec() -> Spec {
         "Annual daylight metrics per sensor (DA, UDI, mean lux, sDA) from an illuminance matrix, with how far each can move within the results' standard errors",
     )
     .usage("[-w weather.wea [-o start end]] [-t lux] [-u low high] [-s share] [-E err ..] [-z z] [-p sensors.pts [-m map.svg]] ill.dat")
-    .opt(Opt::new(
-        "w",
-        Kind::Word,
-        "weather tape (.wea/.epw) whose hours are the matrix's columns; occupied hours from it (default: every column occupied)",
-    ))
-    .opt(Opt::new(
-        "o",
-        Kind::Words(2),
-        "occupied hours of the day, local standard time: start ≤ hour < end (default 8 18; needs -w)",
-    ))
-    .opt(Opt::new("t", Kind::Real, "daylight-autonomy threshold, lux (default 300)"))
-    .opt(Opt::new("u", Kind::Words(2), "useful-daylight range, lux (default 100 2000)"))
-    .opt(Opt::new(
-        "s",
-        Kind::Real,
-        "share of occupied hours a sensor needs for spatial daylight autonomy (default 0.5)",
-    ))
-    .opt(Opt::new(
-        "E",
-        Kind::Word,
-        "standard errors of the matrix (dctimestep -Eo); repeat for summed parts (window groups): added in quadrature",
-    ))
-    .opt(Opt::new("z", Kind::Real, "half-width of the band in standard errors (default 2)"))
-    .opt(Opt::new("p", Kind::Word, "sensor points (x y z dx dy dz per line), for the table's x y columns"))
-    .opt(Opt::new(
-        "m",
-        Kind::Word,
-        "write a floor-plan map (SVG) of DA and UDI per sensor here (needs -p)",
-    ))
+    .opts([
+        Opt::new(
+            "w",
+            Kind::Word,
+            "weather tape (.wea/.epw) whose hours are the matrix's columns; occupied hours from it (default: every column occupied)",
+        ),
+        Opt::new(
+            "o",
+            Kind::Words(2),
+            "occupied hours of the day, local standard time: start ≤ hour < end (default 8 18; needs -w)",
+        ),
+        Opt::new(
+            "t",
+            Kind::Real,
+            "daylight-autonomy threshold, lux (default 300)",
+        ),
+        Opt::new(
+            "u",
+            Kind::Words(2),
+            "useful-daylight range, lux (default 100 2000)",
+        ),
+        Opt::new(
+            "s",
+            Kind::Real,
+            "share of occupied hours a sensor needs for spatial daylight autonomy (default 0.5)",
+        ),
+        Opt::new(
+            "E",
+            Kind::Word,
+            "standard errors of the matrix (dctimestep -Eo); repeat for summed parts (window groups): added in quadrature",
+        ),
+        Opt::new(
+            "z",
+            Kind::Real,
+            "half-width of the band in standard errors (default 2)",
+        ),
+        Opt::new(
+            "p",
+            Kind::Word,
+            "sensor points (x y z dx dy dz per line), for the table's x y columns",
+        ),
+        Opt::new(
+            "m",
+            Kind::Word,
+            "write a floor-plan map (SVG) of DA and UDI per sensor here (needs -p)",
+        ),
+    ])
 }
 
 /// Occupied flags per column from a weather tape's records.
@@ -90,23 +108,20 @@ fn reals2(words: &[String], what: &str) -> Result<(f64, f64)> {
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let mut th = Thresholds::default();
     let (mut wea, mut hours, mut share) = (None::<String>, None::<(f64, f64)>, 0.5f64);
-    let (mut errs, mut pts, mut pos) = (Vec::<String>::new(), None::<String>, Vec::new());
-    let mut map = None::<String>;
-    for it in spec().parse(&args)? {
-        match it {
-            Item::Pos(p) => pos.push(p),
-            Item::Opt(h) => match h.key {
-                "w" => wea = Some(h.word().to_string()),
-                "o" => hours = Some(reals2(h.words(), "-o")?),
-                "t" => th.da = h.real(),
-                "u" => (th.udi_low, th.udi_high) = reals2(h.words(), "-u")?,
-                "s" => share = h.real(),
-                "E" => errs.push(h.word().to_string()),
-                "z" => th.z = h.real(),
-                "p" => pts = Some(h.word().to_string()),
-                "m" => map = Some(h.word().to_string()),
-                _ => unreachable!("declared options only"),
-            },
+    let (mut errs, mut pts, mut map) = (Vec::<String>::new(), None::<String>, None::<String>);
+    let (hits, pos) = spec().parse_apart(&args)?;
+    for h in &hits {
+        match h.key {
+            "w" => wea = Some(h.word().to_string()),
+            "o" => hours = Some(reals2(h.words(), "-o")?),
+            "t" => th.da = h.real(),
+            "u" => (th.udi_low, th.udi_high) = reals2(h.words(), "-u")?,
+            "s" => share = h.real(),
+            "E" => errs.push(h.word().to_string()),
+            "z" => th.z = h.real(),
+            "p" => pts = Some(h.word().to_string()),
+            "m" => map = Some(h.word().to_string()),
+            _ => unreachable!("declared options only"),
         }
     }
     if !(th.z > 0.0 && th.z.is_finite()) {

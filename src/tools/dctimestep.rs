@@ -5,7 +5,7 @@ use fenestra_cli::raypath::Resolver;
 use std::process::ExitCode;
 
 use anyhow::{bail, Result};
-use fenestra_cli::opts::{Item, Kind, Opt, Spec};
+use fenestra_cli::opts::{Kind, Opt, Spec};
 use fenestra_dc::errors::Uncertainty;
 use fenestra_dc::steps::{load_td, matrix_form, picture_form, read_sky, StepOptions};
 use fenestra_formats::matrix::{DataFormat, MatrixReader};
@@ -16,56 +16,58 @@ fn spec() -> Spec {
         "Multiply daylight-coefficient matrices by sky vectors or sky matrices (time steps)",
     )
     .usage("[-n nsteps][-o ospec][-i{f|d}][-o{f|d|c}][-h][-x xr][-y yr] { DCspec | Vspec Tbsdf Dmat } [skyf]")
-    .opt(Opt::new(
-        "n",
-        Kind::Int,
-        "number of time steps; the sky is then read without a header",
-    ))
-    .opt(Opt::new(
-        "o",
-        Kind::Word,
-        "output file; a %d field writes one file per time step",
-    ))
-    .opt(Opt::new("oa", Kind::Flag, "ascii output (default)"))
-    .opt(Opt::new("of", Kind::Flag, "float output"))
-    .opt(Opt::new("od", Kind::Flag, "double output"))
-    .opt(Opt::new("oc", Kind::Flag, "RGBE picture output"))
-    .opt(Opt::new("ia", Kind::Flag, "sky input is ascii"))
-    .opt(Opt::new("if", Kind::Flag, "sky input is float"))
-    .opt(Opt::new("id", Kind::Flag, "sky input is double"))
-    .opt(Opt::new("h", Kind::Flag, "toggle the output header"))
-    .opt(Opt::new(
-        "Ev",
-        Kind::Word,
-        "standard errors of V (or of DC in the two-phase form), as rtcontrib -E writes them (fenestra)",
-    ))
-    .opt(Opt::new(
-        "Ed",
-        Kind::Word,
-        "standard errors of D, as rtcontrib -E writes them (fenestra)",
-    ))
-    .opt(Opt::new(
-        "Rv",
-        Kind::Word,
-        "replicas of V (or of DC), as rtcontrib -E -Er K writes them: errors with every covariance (fenestra)",
-    ))
-    .opt(Opt::new(
-        "Rd",
-        Kind::Word,
-        "replicas of D, as rtcontrib -E -Er K writes them (fenestra)",
-    ))
-    .opt(Opt::new(
-        "Eo",
-        Kind::Word,
-        "write the standard error of every result value here (needs -Ev/-Rv and/or -Ed/-Rd; fenestra)",
-    ))
-    .opt(Opt::new("x", Kind::Int, "output x resolution (reshape)"))
-    .opt(Opt::new("y", Kind::Int, "output y resolution (reshape)"))
+    .opts([
+        Opt::new(
+            "n",
+            Kind::Int,
+            "number of time steps; the sky is then read without a header",
+        ),
+        Opt::new(
+            "o",
+            Kind::Word,
+            "output file; a %d field writes one file per time step",
+        ),
+        Opt::new("oa", Kind::Flag, "ascii output (default)"),
+        Opt::new("of", Kind::Flag, "float output"),
+        Opt::new("od", Kind::Flag, "double output"),
+        Opt::new("oc", Kind::Flag, "RGBE picture output"),
+        Opt::new("ia", Kind::Flag, "sky input is ascii"),
+        Opt::new("if", Kind::Flag, "sky input is float"),
+        Opt::new("id", Kind::Flag, "sky input is double"),
+        Opt::new("h", Kind::Flag, "toggle the output header"),
+        Opt::new(
+            "Ev",
+            Kind::Word,
+            "standard errors of V (or of DC in the two-phase form), as rtcontrib -E writes them (fenestra)",
+        ),
+        Opt::new(
+            "Ed",
+            Kind::Word,
+            "standard errors of D, as rtcontrib -E writes them (fenestra)",
+        ),
+        Opt::new(
+            "Rv",
+            Kind::Word,
+            "replicas of V (or of DC), as rtcontrib -E -Er K writes them: errors with every covariance (fenestra)",
+        ),
+        Opt::new(
+            "Rd",
+            Kind::Word,
+            "replicas of D, as rtcontrib -E -Er K writes them (fenestra)",
+        ),
+        Opt::new(
+            "Eo",
+            Kind::Word,
+            "write the standard error of every result value here (needs -Ev/-Rv and/or -Ed/-Rd; fenestra)",
+        ),
+        Opt::new("x", Kind::Int, "output x resolution (reshape)"),
+        Opt::new("y", Kind::Int, "output y resolution (reshape)"),
+    ])
 }
 
 /// Runs dctimestep.
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
-    let items = spec().parse(&args)?;
+    let (hits, pos) = spec().parse_apart(&args)?;
     let mut o = StepOptions {
         nsteps: None,
         in_fmt: None,
@@ -76,52 +78,45 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         header: true,
         command: fenestra_cli::command_line(&args),
     };
-    let mut pos = Vec::new();
     let mut oc_given = false;
     let (mut ev, mut ed, mut eo): (Option<String>, Option<String>, Option<String>) =
         (None, None, None);
     let (mut rv, mut rd): (Option<String>, Option<String>) = (None, None);
-    for it in items {
-        match it {
-            Item::Pos(p) => pos.push(p),
-            Item::Opt(h) => match h.key {
-                "n" => {
-                    let n = h.int();
-                    if n <= 0 {
-                        bail!("-n {n}: the number of time steps must be positive");
-                    }
-                    o.nsteps = Some(n as usize);
+    for h in &hits {
+        match h.key {
+            "n" => {
+                let n = h.positive_int(|n| {
+                    format!("-n {n}: the number of time steps must be positive")
+                })?;
+                o.nsteps = Some(n as usize);
+            }
+            "o" => o.out_spec = Some(h.word().to_string()),
+            "oa" => o.out_fmt = DataFormat::Ascii,
+            "of" => o.out_fmt = DataFormat::Float,
+            "od" => o.out_fmt = DataFormat::Double,
+            "oc" => {
+                o.out_fmt = DataFormat::Rgbe;
+                oc_given = true;
+            }
+            "ia" => o.in_fmt = Some(DataFormat::Ascii),
+            "if" => o.in_fmt = Some(DataFormat::Float),
+            "id" => o.in_fmt = Some(DataFormat::Double),
+            "h" => o.header = !o.header,
+            "Ev" => ev = Some(h.word().to_string()),
+            "Ed" => ed = Some(h.word().to_string()),
+            "Eo" => eo = Some(h.word().to_string()),
+            "Rv" => rv = Some(h.word().to_string()),
+            "Rd" => rd = Some(h.word().to_string()),
+            "x" | "y" => {
+                let v =
+                    h.positive_int(|v| format!("-{} {v}: resolution must be positive", h.key))?;
+                if h.key == "x" {
+                    o.xres = Some(v as usize);
+                } else {
+                    o.yres = Some(v as usize);
                 }
-                "o" => o.out_spec = Some(h.word().to_string()),
-                "oa" => o.out_fmt = DataFormat::Ascii,
-                "of" => o.out_fmt = DataFormat::Float,
-                "od" => o.out_fmt = DataFormat::Double,
-                "oc" => {
-                    o.out_fmt = DataFormat::Rgbe;
-                    oc_given = true;
-                }
-                "ia" => o.in_fmt = Some(DataFormat::Ascii),
-                "if" => o.in_fmt = Some(DataFormat::Float),
-                "id" => o.in_fmt = Some(DataFormat::Double),
-                "h" => o.header = !o.header,
-                "Ev" => ev = Some(h.word().to_string()),
-                "Ed" => ed = Some(h.word().to_string()),
-                "Eo" => eo = Some(h.word().to_string()),
-                "Rv" => rv = Some(h.word().to_string()),
-                "Rd" => rd = Some(h.word().to_string()),
-                "x" | "y" => {
-                    let v = h.int();
-                    if v <= 0 {
-                        bail!("-{} {v}: resolution must be positive", h.key);
-                    }
-                    if h.key == "x" {
-                        o.xres = Some(v as usize);
-                    } else {
-                        o.yres = Some(v as usize);
-                    }
-                }
-                _ => bail!("unexpected option '{}'", h.text),
-            },
+            }
+            _ => bail!("unexpected option '{}'", h.text),
         }
     }
     if pos.is_empty() || pos.len() > 4 {

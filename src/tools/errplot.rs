@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 use fenestra_chart::{Chart, Level, Series};
-use fenestra_cli::opts::{Item, Kind, Opt, Spec};
+use fenestra_cli::opts::{Kind, Opt, Spec};
 
 fn spec() -> Spec {
     Spec::new(
@@ -16,24 +16,22 @@ fn spec() -> Spec {
     .usage(
         "[-t title] [-x label] [-y label] [-g series ..] [-H y label ..] [-o out.svg] [table | -]",
     )
-    .opt(Opt::new("t", Kind::Word, "title"))
-    .opt(Opt::new("x", Kind::Word, "x-axis label, with its unit"))
-    .opt(Opt::new("y", Kind::Word, "y-axis label, with its unit"))
-    .opt(Opt::new(
-        "g",
-        Kind::Word,
-        "draw a 1/sqrt(x) guide through this series' first point (repeatable)",
-    ))
-    .opt(Opt::new(
-        "H",
-        Kind::Words(2),
-        "a horizontal line at y with a legend text (repeatable)",
-    ))
-    .opt(Opt::new(
-        "o",
-        Kind::Word,
-        "output file (default: standard output)",
-    ))
+    .opts([
+        Opt::new("t", Kind::Word, "title"),
+        Opt::new("x", Kind::Word, "x-axis label, with its unit"),
+        Opt::new("y", Kind::Word, "y-axis label, with its unit"),
+        Opt::new(
+            "g",
+            Kind::Word,
+            "draw a 1/sqrt(x) guide through this series' first point (repeatable)",
+        ),
+        Opt::new(
+            "H",
+            Kind::Words(2),
+            "a horizontal line at y with a legend text (repeatable)",
+        ),
+        Opt::new("o", Kind::Word, "output file (default: standard output)"),
+    ])
 }
 
 /// Reads `series<TAB>x<TAB>y` lines (`#` comments and blank lines skipped), series in the
@@ -80,28 +78,26 @@ fn read_table(rd: &mut dyn BufRead, name: &str) -> Result<Vec<Series>> {
 /// Runs errplot.
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let mut chart = Chart::default();
-    let (mut guides, mut out, mut pos) = (Vec::<String>::new(), None::<String>, Vec::new());
-    for it in spec().parse(&args)? {
-        match it {
-            Item::Pos(p) => pos.push(p),
-            Item::Opt(h) => match h.key {
-                "t" => chart.title = h.word().to_string(),
-                "x" => chart.x_label = h.word().to_string(),
-                "y" => chart.y_label = h.word().to_string(),
-                "g" => guides.push(h.word().to_string()),
-                "H" => {
-                    let w = h.words();
-                    let y = fenestra_cli::opts::parse_real(&w[0])
-                        .filter(|v| v.is_finite() && *v > 0.0)
-                        .with_context(|| format!("-H {}: a positive y value expected", w[0]))?;
-                    chart.levels.push(Level {
-                        y,
-                        name: w[1].clone(),
-                    });
-                }
-                "o" => out = Some(h.word().to_string()),
-                _ => unreachable!("declared options only"),
-            },
+    let (mut guides, mut out) = (Vec::<String>::new(), None::<String>);
+    let (hits, pos) = spec().parse_apart(&args)?;
+    for h in &hits {
+        match h.key {
+            "t" => chart.title = h.word().to_string(),
+            "x" => chart.x_label = h.word().to_string(),
+            "y" => chart.y_label = h.word().to_string(),
+            "g" => guides.push(h.word().to_string()),
+            "H" => {
+                let w = h.words();
+                let y = fenestra_cli::opts::parse_real(&w[0])
+                    .filter(|v| v.is_finite() && *v > 0.0)
+                    .with_context(|| format!("-H {}: a positive y value expected", w[0]))?;
+                chart.levels.push(Level {
+                    y,
+                    name: w[1].clone(),
+                });
+            }
+            "o" => out = Some(h.word().to_string()),
+            _ => unreachable!("declared options only"),
         }
     }
     let (name, mut rd): (String, Box<dyn BufRead>) = match pos.as_slice() {

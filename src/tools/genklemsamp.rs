@@ -5,39 +5,40 @@
 use std::io::Write;
 use std::process::ExitCode;
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use fenestra_calc::format::fmt_g;
-use fenestra_cli::opts::{Item, Kind, Opt, Spec};
+use fenestra_cli::opts::{Kind, Opt, Spec};
+use fenestra_cli::rays::format_suffix;
 use fenestra_contrib::klemsamp::{aperture_from_scene, frame, Aperture, KlemsSampler};
 use fenestra_formats::view::View;
 
 use super::view_opts;
 
 fn spec() -> Spec {
-    let mut s = Spec::new(
+    Spec::new(
         "genklemsamp",
         "Rays over a window's area in the directions of the 145 Klems Full patches (N per patch, patch order)",
     )
     .usage("[-c N][-f{a|f|d}][-s seed] [view options] [window.rad ..]")
     .interleaved(true)
-    .opt(Opt::new("c", Kind::Int, "rays per Klems patch (default 1000)"))
-    .opt(Opt::new(
-        "f",
-        Kind::Attached,
-        "output format: a ascii (default), f float, d double",
-    ))
-    .opt(Opt::new(
-        "s",
-        Kind::Int,
-        "random seed (fenestra extension; default 0: output is reproducible)",
-    ));
-    for o in view_opts::options() {
-        if matches!(o.key, "vt" | "va" | "vs" | "vl") {
-            continue;
-        }
-        s = s.opt(o);
-    }
-    s
+    .opts([
+        Opt::new("c", Kind::Int, "rays per Klems patch (default 1000)"),
+        Opt::new(
+            "f",
+            Kind::Attached,
+            "output format: a ascii (default), f float, d double",
+        ),
+        Opt::new(
+            "s",
+            Kind::Int,
+            "random seed (fenestra extension; default 0: output is reproducible)",
+        ),
+    ])
+    .opts(
+        view_opts::options()
+            .into_iter()
+            .filter(|o| !matches!(o.key, "vt" | "va" | "vs" | "vl")),
+    )
 }
 
 /// The `-f` number-stream format (one type for every tool).
@@ -45,7 +46,7 @@ type Fmt = fenestra_cli::rays::RayFormat;
 
 /// Runs genklemsamp.
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
-    let items = spec().parse(&args)?;
+    let (hits, files) = spec().parse_apart(&args)?;
     let mut n: i64 = 1000;
     let mut fmt = Fmt::Ascii;
     let mut seed: u64 = 0;
@@ -55,32 +56,25 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         .map_err(|e| anyhow::anyhow!("{e}"))?;
     view.apply_option(&["-vo".to_string(), "1e-5".to_string()])
         .map_err(|e| anyhow::anyhow!("{e}"))?;
-    let mut files = Vec::new();
-    for it in &items {
-        match it {
-            Item::Pos(p) => files.push(p.clone()),
-            Item::Opt(h) => match h.key {
-                "c" => {
-                    n = h.int();
-                    if n <= 0 {
-                        bail!("-c needs a positive number of rays per patch (got {n})");
-                    }
+    for h in &hits {
+        match h.key {
+            "c" => {
+                n = h.positive_int(|n| {
+                    format!("-c needs a positive number of rays per patch (got {n})")
+                })?;
+            }
+            "f" => {
+                let w = h.word();
+                fmt = format_suffix(w).with_context(|| {
+                    format!("-f{w}: unknown output format (expected -fa, -ff or -fd)")
+                })?;
+            }
+            "s" => seed = h.int() as u64,
+            _ => {
+                if !view_opts::apply(&mut view, h, "genklemsamp")? {
+                    bail!("unknown option -{}", h.key);
                 }
-                "f" => {
-                    let w = h.word();
-                    let mut c = w.chars();
-                    fmt = match (c.next().and_then(Fmt::from_letter), c.next()) {
-                        (Some(f), None) => f,
-                        _ => bail!("-f{w}: unknown output format (expected -fa, -ff or -fd)"),
-                    }
-                }
-                "s" => seed = h.int() as u64,
-                _ => {
-                    if !view_opts::apply(&mut view, h, "genklemsamp")? {
-                        bail!("unknown option -{}", h.key);
-                    }
-                }
-            },
+            }
         }
     }
     let n = n as usize;

@@ -104,6 +104,16 @@ fn value(args: &[String], i: usize) -> Result<f64> {
     }
 }
 
+/// A value given with an upper-case option letter (`-B`, `-R`) is a horizontal irradiance,
+/// with a lower-case one (`-b`, `-r`) a radiance.
+fn given(letter: u8, v: f64) -> Given {
+    if letter.is_ascii_uppercase() {
+        Given::Irradiance(v)
+    } else {
+        Given::Radiance(v)
+    }
+}
+
 /// `gensky --help`: the synopsis and one line per option.
 const GENSKY_HELP: &str = "Usage: gensky month day hour [options]      (hour: local standard time, e.g. 14:30 or 14.5; +H or a zone suffix as Radiance)
    Or: gensky -ang altitude azimuth [options]   (sun position in degrees, azimuth from south, west positive)
@@ -179,12 +189,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             }
             b'r' | b'R' => {
                 i += 1;
-                let v = value(&args, i)?;
-                inp.solar = if a[1] == b'R' {
-                    Given::Irradiance(v)
-                } else {
-                    Given::Radiance(v)
-                };
+                inp.solar = given(a[1], value(&args, i)?);
             }
             b'c' => inp.sky_type = SkyType::Overcast,
             b'u' => inp.sky_type = SkyType::Uniform,
@@ -198,12 +203,7 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
             }
             b'b' | b'B' => {
                 i += 1;
-                let v = value(&args, i)?;
-                inp.zenith = if a[1] == b'B' {
-                    Given::Irradiance(v)
-                } else {
-                    Given::Radiance(v)
-                };
+                inp.zenith = given(a[1], value(&args, i)?);
             }
             b'g' => {
                 i += 1;

@@ -1,7 +1,7 @@
 //! genskyvec: Reinhart sky vector of a gensky/gendaylit sky description.
 
 use anyhow::{anyhow, bail, Context, Result};
-use fenestra_cli::opts::{Item, Kind, Opt, Spec};
+use fenestra_cli::opts::{Kind, Opt, Spec};
 use fenestra_scene::{Parser, Primitive};
 use fenestra_sky::cie::SkyBright;
 use fenestra_sky::daymtx::fmt_g;
@@ -76,46 +76,49 @@ fn spec() -> Spec {
         "Reinhart sky vector (ground first) of a sky description (gensky, gendaylit) on standard input",
     )
     .usage("[-h][-m N][-c r g b][-d][-5] < sky.rad")
-    .opt(Opt::new(
-        "m",
-        Kind::Int,
-        "Reinhart subdivision: 146, 578, 2306 rows for 1, 2, 4 (default 4: match D's -m/MF!)",
-    ))
-    .opt(Opt::new(
-        "c",
-        Kind::Vec3,
-        "sky colour r g b (default 0.960 1.004 1.118)",
-    ))
-    .opt(Opt::new("d", Kind::Flag, "sun only (sky patches zero)"))
-    .opt(Opt::new(
-        "5",
-        Kind::Flag,
-        "five-phase: the sun into its single nearest patch",
-    ))
-    .opt(Opt::new("h", Kind::Flag, "no header"))
+    .opts([
+        Opt::new(
+            "m",
+            Kind::Int,
+            "Reinhart subdivision: 146, 578, 2306 rows for 1, 2, 4 (default 4: match D's -m/MF!)",
+        ),
+        Opt::new(
+            "c",
+            Kind::Vec3,
+            "sky colour r g b (default 0.960 1.004 1.118)",
+        ),
+        Opt::new("d", Kind::Flag, "sun only (sky patches zero)"),
+        Opt::new(
+            "5",
+            Kind::Flag,
+            "five-phase: the sun into its single nearest patch",
+        ),
+        Opt::new("h", Kind::Flag, "no header"),
+    ])
 }
 
 /// Runs genskyvec.
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
     let mut opt = SkyVecOptions::default();
     let mut header = true;
-    for it in spec().parse(&args)? {
-        match it {
-            Item::Pos(w) => bail!("Unexpected command-line argument: {w}"),
-            Item::Opt(o) => match o.key {
-                "c" => opt.color = o.vec3(),
-                "m" => {
-                    opt.mf = usize::try_from(o.int())
-                        .ok()
-                        .filter(|&v| v >= 1)
-                        .ok_or_else(|| anyhow!("-m needs a positive integer, got {}", o.int()))?;
-                }
-                "d" => opt.sky = false,
-                "h" => header = false,
-                "5" => opt.five_phase = true,
-                _ => {}
-            },
+    let (hits, words) = spec().parse_apart(&args)?;
+    for o in &hits {
+        match o.key {
+            "c" => opt.color = o.vec3(),
+            "m" => {
+                opt.mf = usize::try_from(o.int())
+                    .ok()
+                    .filter(|&v| v >= 1)
+                    .ok_or_else(|| anyhow!("-m needs a positive integer, got {}", o.int()))?;
+            }
+            "d" => opt.sky = false,
+            "h" => header = false,
+            "5" => opt.five_phase = true,
+            _ => {}
         }
+    }
+    if let Some(w) = words.first() {
+        bail!("Unexpected command-line argument: {w}");
     }
     let mut text = String::new();
     std::io::stdin()

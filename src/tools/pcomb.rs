@@ -23,52 +23,50 @@ fn spec() -> Spec {
     )
     .usage("[-h][-w][-ff][-x xres][-y yres][-e expr][-f file] [[-o][-s factor][-c r g b] input ..]")
     .interleaved(true)
-    .opt(Opt::new(
-        "h",
-        Kind::Flag,
-        "leave the inputs' headers out of the output header",
-    ))
-    .opt(Opt::new("w", Kind::Flag, "suppress warnings"))
-    .opt(Opt::new(
-        "ff",
-        Kind::Flag,
-        "write a float RGB matrix (no clipping of negatives)",
-    ))
-    .opt(Opt::new(
-        "x",
-        Kind::Word,
-        "output x resolution (default: the inputs')",
-    ))
-    .opt(Opt::new(
-        "y",
-        Kind::Word,
-        "output y resolution (default: the inputs')",
-    ))
-    .opt(Opt::new(
-        "e",
-        Kind::Word,
-        "expression defining ro go bo (or lo) from ri(n) gi(n) bi(n) li(n), x, y …",
-    ))
-    .opt(Opt::new(
-        "f",
-        Kind::Word,
-        "file of expressions (found through RAYPATH)",
-    ))
-    .opt(Opt::new(
-        "o",
-        Kind::Flag,
-        "use original values of the next input (undo its exposure)",
-    ))
-    .opt(Opt::new(
-        "s",
-        Kind::Real,
-        "scale the next input by a factor",
-    ))
-    .opt(Opt::new(
-        "c",
-        Kind::Words(3),
-        "scale the next input's r g b by these factors",
-    ))
+    .opts([
+        Opt::new(
+            "h",
+            Kind::Flag,
+            "leave the inputs' headers out of the output header",
+        ),
+        Opt::new("w", Kind::Flag, "suppress warnings"),
+        Opt::new(
+            "ff",
+            Kind::Flag,
+            "write a float RGB matrix (no clipping of negatives)",
+        ),
+        Opt::new(
+            "x",
+            Kind::Word,
+            "output x resolution (default: the inputs')",
+        ),
+        Opt::new(
+            "y",
+            Kind::Word,
+            "output y resolution (default: the inputs')",
+        ),
+        Opt::new(
+            "e",
+            Kind::Word,
+            "expression defining ro go bo (or lo) from ri(n) gi(n) bi(n) li(n), x, y …",
+        ),
+        Opt::new(
+            "f",
+            Kind::Word,
+            "file of expressions (found through RAYPATH)",
+        ),
+        Opt::new(
+            "o",
+            Kind::Flag,
+            "use original values of the next input (undo its exposure)",
+        ),
+        Opt::new("s", Kind::Real, "scale the next input by a factor"),
+        Opt::new(
+            "c",
+            Kind::Words(3),
+            "scale the next input's r g b by these factors",
+        ),
+    ])
 }
 
 /// Runs pcomb.

@@ -4,7 +4,8 @@ use std::io::{Read, Write};
 use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
-use fenestra_cli::opts::{Item, Kind, Opt, Spec};
+use fenestra_cli::opts::{Kind, Opt, Spec};
+use fenestra_cli::rays::format_suffix;
 use fenestra_formats::picture::{read_header_lines, read_resolution, PictureInfo};
 use fenestra_formats::resolution::Resolution;
 use fenestra_formats::view::{normaspect, View, FTINY};
@@ -13,27 +14,53 @@ use fenestra_formats::view_rays::{pix2rays, put_rays, Fmt, Settings};
 use super::view_opts;
 
 fn spec() -> Spec {
-    let mut s = Spec::new("vwrays", "Compute the ray through each pixel of a view or picture")
-        .usage("[-i -u -f{a|f|d} -c N | -d] [-x X -y Y -pa A -pj J -pd D] { view options | picture [zbuf] }")
-        .opt(Opt::new("x", Kind::Int, "target x resolution (default 512)"))
-        .opt(Opt::new("y", Kind::Int, "target y resolution (default 512)"))
-        .opt(Opt::new("pa", Kind::Real, "pixel aspect ratio; 0 keeps -x -y (default 1)"))
-        .opt(Opt::new("pj", Kind::Real, "pixel jitter fraction (default 0)"))
-        .opt(Opt::new("pd", Kind::Real, "aperture diameter for depth of field (default 0)"))
-        .opt(Opt::new("c", Kind::Int, "repeat each ray N times (pairs with rtcontrib -c N)"))
-        .opt(Opt::new("f", Kind::Attached, "output format: a ascii, f float, d double"))
-        .opt(Opt::new("i", Kind::Flag, "read pixel positions 'x y' from standard input"))
-        .opt(Opt::new("u", Kind::Flag, "flush output after each ray"))
-        .opt(Opt::new("d", Kind::Flag, "print the resolution (-x X -y Y [-ld+]) and stop"));
-    for o in view_opts::options() {
-        s = s.opt(o);
-    }
-    s
+    Spec::new(
+        "vwrays",
+        "Compute the ray through each pixel of a view or picture",
+    )
+    .usage("[-i -u -f{a|f|d} -c N | -d] [-x X -y Y -pa A -pj J -pd D] { view options | picture [zbuf] }")
+    .opts([
+        Opt::new("x", Kind::Int, "target x resolution (default 512)"),
+        Opt::new("y", Kind::Int, "target y resolution (default 512)"),
+        Opt::new(
+            "pa",
+            Kind::Real,
+            "pixel aspect ratio; 0 keeps -x -y (default 1)",
+        ),
+        Opt::new("pj", Kind::Real, "pixel jitter fraction (default 0)"),
+        Opt::new(
+            "pd",
+            Kind::Real,
+            "aperture diameter for depth of field (default 0)",
+        ),
+        Opt::new(
+            "c",
+            Kind::Int,
+            "repeat each ray N times (pairs with rtcontrib -c N)",
+        ),
+        Opt::new(
+            "f",
+            Kind::Attached,
+            "output format: a ascii, f float, d double",
+        ),
+        Opt::new(
+            "i",
+            Kind::Flag,
+            "read pixel positions 'x y' from standard input",
+        ),
+        Opt::new("u", Kind::Flag, "flush output after each ray"),
+        Opt::new(
+            "d",
+            Kind::Flag,
+            "print the resolution (-x X -y Y [-ld+]) and stop",
+        ),
+    ])
+    .opts(view_opts::options())
 }
 
 /// Runs vwrays.
 pub fn run(args: Vec<String>) -> Result<ExitCode> {
-    let items = spec().parse(&args)?;
+    let (hits, pos) = spec().parse_apart(&args)?;
     let (mut xres, mut yres, mut pa) = (512i64, 512i64, 1.0f64);
     let mut set = Settings {
         fmt: Fmt::Ascii,
@@ -44,44 +71,28 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     };
     let (mut from_stdin, mut getdim) = (false, false);
     let mut view = View::default();
-    let mut pos = Vec::new();
-    for it in &items {
-        match it {
-            Item::Pos(p) => pos.push(p.clone()),
-            Item::Opt(h) => match h.key {
-                "x" => {
-                    xres = h.int();
-                    if xres <= 0 {
-                        bail!("bad x resolution {xres}");
-                    }
+    for h in &hits {
+        match h.key {
+            "x" => xres = h.positive_int(|x| format!("bad x resolution {x}"))?,
+            "y" => yres = h.positive_int(|y| format!("bad y resolution {y}"))?,
+            "pa" => pa = h.real(),
+            "pj" => set.pj = h.real(),
+            "pd" => set.pd = h.real(),
+            "c" => set.repeat = h.int(),
+            "f" => {
+                let w = h.word();
+                set.fmt = format_suffix(w).with_context(|| {
+                    format!("unknown output format '-f{w}' (expected -fa, -ff or -fd)")
+                })?;
+            }
+            "i" => from_stdin = true,
+            "u" => set.unbuffered = true,
+            "d" => getdim = true,
+            _ => {
+                if !view_opts::apply(&mut view, h, "vwrays")? {
+                    bail!("unexpected option '{}'", h.text);
                 }
-                "y" => {
-                    yres = h.int();
-                    if yres <= 0 {
-                        bail!("bad y resolution {yres}");
-                    }
-                }
-                "pa" => pa = h.real(),
-                "pj" => set.pj = h.real(),
-                "pd" => set.pd = h.real(),
-                "c" => set.repeat = h.int(),
-                "f" => {
-                    let w = h.word();
-                    let mut c = w.chars();
-                    set.fmt = match (c.next().and_then(Fmt::from_letter), c.next()) {
-                        (Some(f), None) => f,
-                        _ => bail!("unknown output format '-f{w}' (expected -fa, -ff or -fd)"),
-                    }
-                }
-                "i" => from_stdin = true,
-                "u" => set.unbuffered = true,
-                "d" => getdim = true,
-                _ => {
-                    if !view_opts::apply(&mut view, h, "vwrays")? {
-                        bail!("unexpected option '{}'", h.text);
-                    }
-                }
-            },
+            }
         }
     }
     if pos.len() > 2 {

@@ -2,6 +2,9 @@
 //! implementation (oracle), fixtures and scratch folders.
 #![allow(dead_code)]
 
+pub mod cli;
+pub mod probe;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -109,16 +112,49 @@ pub fn run_ok(cmd: &mut Command) -> Vec<u8> {
 /// Runs a command, asserting success, and returns its whole output (stdout, and stderr
 /// with its messages and `-v` lines).
 pub fn output_ok(cmd: &mut Command) -> std::process::Output {
+    let what = format!("{cmd:?}");
+    output_named(cmd, &what)
+}
+
+/// Runs a command, asserting success (`what` names it in the messages); returns its output.
+fn output_named(cmd: &mut Command, what: &str) -> std::process::Output {
     let out = cmd
         .output()
-        .unwrap_or_else(|e| panic!("cannot run {cmd:?}: {e}"));
+        .unwrap_or_else(|e| panic!("cannot run {what}: {e}"));
+    check_status(&out, &format!("{what} failed"));
+    out
+}
+
+/// Asserts that a tool succeeded, else panics with `msg`, its exit status and its stderr.
+#[track_caller]
+fn check_status(out: &std::process::Output, msg: &str) {
     assert!(
         out.status.success(),
-        "{cmd:?} failed ({}): {}",
+        "{msg} ({}): {}",
         out.status,
         String::from_utf8_lossy(&out.stderr)
     );
-    out
+}
+
+/// Asserts that a tool succeeded, else panics with its stderr.
+#[track_caller]
+pub fn assert_ok(out: &std::process::Output) {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// Runs a command that must fail (the failure message is `what`); returns its stdout and its
+/// stderr as text.
+pub fn output_err(cmd: &mut Command, what: &str) -> (Vec<u8>, String) {
+    let out = cmd
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run {cmd:?}: {e}"));
+    assert!(!out.status.success(), "{what}");
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    (out.stdout, err)
 }
 
 /// Runs a command with `input` on its stdin and returns its whole output. A tool that
@@ -148,13 +184,17 @@ pub fn run_stdin(mut cmd: Command, input: &[u8]) -> std::process::Output {
 /// [`run_stdin`], asserting success (the failure shows the tool's stderr).
 pub fn run_stdin_ok(cmd: Command, input: &[u8]) -> std::process::Output {
     let out = run_stdin(cmd, input);
-    assert!(
-        out.status.success(),
-        "failed ({}): {}",
-        out.status,
-        String::from_utf8_lossy(&out.stderr)
-    );
+    check_status(&out, "failed");
     out
+}
+
+/// [`run_stdin`], asserting success (the failure message is the tool's stderr); returns its
+/// stdout.
+#[track_caller]
+pub fn pipe_ok(cmd: Command, input: &[u8]) -> Vec<u8> {
+    let out = run_stdin(cmd, input);
+    assert_ok(&out);
+    out.stdout
 }
 
 /// Runs a repository script (`bash REPO/rel args…`) with the test build's binaries
@@ -170,15 +210,7 @@ pub fn run_script(rel: &str, args: &[&std::ffi::OsStr], env: &[(&str, &Path)]) -
     for (k, v) in env {
         c.env(k, v);
     }
-    let out = c
-        .output()
-        .unwrap_or_else(|e| panic!("cannot run {rel}: {e}"));
-    assert!(
-        out.status.success(),
-        "{rel} failed ({}): {}",
-        out.status,
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = output_named(&mut c, rel);
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
@@ -197,20 +229,78 @@ pub fn numbers(out: &[u8]) -> Vec<f64> {
 /// the same options and rays; returns (theirs, ours), having checked both succeeded and
 /// gave as many numbers.
 pub fn both_rtrace(oracle: &Oracle, dir: &Path, opts: &[&str], rays: &str) -> (Vec<f64>, Vec<f64>) {
-    let mut c = oracle.command("oconv");
-    c.arg("scene.rad").current_dir(dir);
-    std::fs::write(dir.join("scene.oct"), run_ok(&mut c)).unwrap();
+    oracle_octree(oracle, dir, &["scene.rad"]);
     let mut theirs = oracle.command("rtrace");
     theirs.args(opts).arg("scene.oct").current_dir(dir);
-    let t = run_stdin(theirs, rays.as_bytes());
-    assert!(t.status.success(), "{}", String::from_utf8_lossy(&t.stderr));
+    let t = pipe_ok(theirs, rays.as_bytes());
     let mut ours = fenestra("rtrace");
     ours.args(opts).arg("scene.rad").current_dir(dir);
-    let o = run_stdin(ours, rays.as_bytes());
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let (t, o) = (numbers(&t.stdout), numbers(&o.stdout));
+    let o = pipe_ok(ours, rays.as_bytes());
+    let (t, o) = (numbers(&t), numbers(&o));
     assert_eq!(t.len(), o.len());
     (t, o)
+}
+
+/// Compiles the scene files `scene` of `dir` with the oracle's oconv into `dir/scene.oct`.
+pub fn oracle_octree(oracle: &Oracle, dir: &Path, scene: &[&str]) {
+    let mut c = oracle.command("oconv");
+    c.args(scene).current_dir(dir);
+    std::fs::write(dir.join("scene.oct"), run_ok(&mut c)).unwrap();
+}
+
+/// Direct light without jitter (`-ab 0 -ss 0`, the oracle also `-aa 0`: deterministic in both
+/// tools) along `rays` in the scene files `scene` of `dir`: the oracle's rtrace (on the octree
+/// of its oconv) and ours (RAYPATH `dir`); returns (theirs, ours), as many numbers each.
+pub fn direct_both(
+    oracle: &Oracle,
+    dir: &Path,
+    scene: &[&str],
+    rays: &str,
+) -> (Vec<f64>, Vec<f64>) {
+    oracle_octree(oracle, dir, scene);
+    let mut c = oracle.command("rtrace");
+    c.args(["-h", "-aa", "0", "-ab", "0", "-ss", "0", "scene.oct"])
+        .current_dir(dir);
+    let theirs = numbers(&run_stdin(c, rays.as_bytes()).stdout);
+    let mut c = fenestra("rtrace");
+    c.args(["-h", "-ab", "0", "-ss", "0"])
+        .args(scene)
+        .current_dir(dir);
+    c.env("RAYPATH", dir);
+    let ours = numbers(&run_stdin(c, rays.as_bytes()).stdout);
+    assert_eq!(theirs.len(), ours.len());
+    (theirs, ours)
+}
+
+/// A tool's output without its first line (the command, which names the program path).
+pub fn tail(b: &[u8]) -> String {
+    let s = String::from_utf8_lossy(b);
+    s.split_once('\n').map(|x| x.1).unwrap_or("").to_string()
+}
+
+/// Runs the oracle's `tool` and ours on each of `cases` (when the oracle is present), hands
+/// `check` the case and both outputs (theirs, ours), and asserts that the outputs' [`tail`]s
+/// are identical; the cases that differ are printed with both texts.
+pub fn tails_match_oracle(
+    tool: &str,
+    cases: &[Vec<String>],
+    check: impl Fn(&[String], &std::process::Output, &std::process::Output),
+) {
+    let Some(o) = oracle() else { return };
+    let mut bad = Vec::new();
+    for a in cases {
+        let want = o.command(tool).args(a).output().unwrap();
+        let got = fenestra(tool).args(a).output().unwrap();
+        check(a, &want, &got);
+        let (w, g) = (tail(&want.stdout), tail(&got.stdout));
+        if w != g {
+            bad.push(format!("{}\n--- oracle\n{w}--- ours\n{g}", a.join(" ")));
+        }
+    }
+    for b in &bad {
+        eprintln!("{b}");
+    }
+    assert!(bad.is_empty(), "{} of {} differ", bad.len(), cases.len());
 }
 
 /// A xorshift64 generator of numbers in [0, 1) from `seed` (test data that is the same
@@ -221,6 +311,41 @@ pub fn xorshift(mut seed: u64) -> impl FnMut() -> f64 {
         seed ^= seed >> 7;
         seed ^= seed << 17;
         (seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// A 64-bit linear congruential generator (Knuth's MMIX constants): test cases that are the
+/// same on every run and machine, without external crates.
+pub struct Lcg(pub u64);
+
+impl Lcg {
+    /// Advances the state and returns it.
+    pub fn step(&mut self) -> u64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        self.0
+    }
+
+    /// The top 31 bits of the next state.
+    pub fn bits(&mut self) -> u64 {
+        self.step() >> 33
+    }
+
+    /// A number in [0, 1): the top 53 bits of the next state.
+    pub fn unit(&mut self) -> f64 {
+        (self.step() >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// A number from `lo` (included) to `hi` (excluded).
+    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.unit()
+    }
+
+    /// One of the words `v`, each as likely.
+    pub fn pick<'a>(&mut self, v: &[&'a str]) -> &'a str {
+        v[(self.unit() * v.len() as f64) as usize % v.len()]
     }
 }
 

@@ -359,24 +359,25 @@ impl KlemsBasis {
 
     /// Solid angle of a patch (sr): `2π (cos θlo − cos θhi) / n`.
     pub fn solid_angle(&self, patch: usize) -> Option<f64> {
-        let (r, _) = self.ring_of(patch)?;
-        let ring = &self.rings[r];
-        let (c_lo, c_hi) = (
-            ring.theta_lo.to_radians().cos(),
-            ring.theta_hi.to_radians().cos(),
-        );
-        Some(2.0 * PI * (c_lo - c_hi) / ring.nphi as f64)
+        let (c_lo, c_hi, n) = self.ring_cosines(patch)?;
+        Some(2.0 * PI * (c_lo - c_hi) / n)
     }
 
     /// Projected solid angle ("lambda") of a patch (sr): `π (cos²θlo − cos²θhi) / n`.
     pub fn projected_solid_angle(&self, patch: usize) -> Option<f64> {
+        let (c_lo, c_hi, n) = self.ring_cosines(patch)?;
+        Some(PI * (c_lo * c_lo - c_hi * c_hi) / n)
+    }
+
+    /// Cosines of the polar bounds of a patch's ring, and its number of patches `n`.
+    fn ring_cosines(&self, patch: usize) -> Option<(f64, f64, f64)> {
         let (r, _) = self.ring_of(patch)?;
         let ring = &self.rings[r];
         let (c_lo, c_hi) = (
             ring.theta_lo.to_radians().cos(),
             ring.theta_hi.to_radians().cos(),
         );
-        Some(PI * (c_lo * c_lo - c_hi * c_hi) / ring.nphi as f64)
+        Some((c_lo, c_hi, ring.nphi as f64))
     }
 
     /// Projected solid angles of all patches, in patch order.

@@ -454,6 +454,20 @@ struct Component<'a> {
 }
 
 impl Component<'_> {
+    /// The matrix `M[o][i] = RGB[o][i] · λ_in(i)` (rows outgoing, columns incident patches).
+    fn weighted_matrix(&self) -> RgbMatrix {
+        let (ni, no) = (self.y.incident.len(), self.y.outgoing.len());
+        let lam = self.y.incident.lambdas();
+        let mut m = RgbMatrix::zeros(no, ni);
+        for o in 0..no {
+            for (i, l) in lam.iter().enumerate() {
+                let v = self.rgb(o, i);
+                m.data[o * ni + i] = [v[0] * l, v[1] * l, v[2] * l];
+            }
+        }
+        m
+    }
+
     fn rgb(&self, o: usize, i: usize) -> [f64; 3] {
         let k = o * self.y.incident.len() + i;
         let y = self.y.values[k];
@@ -740,16 +754,7 @@ pub fn transmission_matrix_with(b: &Bsdf, rng: &mut Drand48) -> Result<RgbMatrix
     if let Some(tb) = tb {
         let (lamb, keep) = tb.split();
         if keep {
-            let (ni, no) = (tb.y.incident.len(), tb.y.outgoing.len());
-            let lam = tb.y.incident.lambdas();
-            let mut t = RgbMatrix::zeros(no, ni);
-            for o in 0..no {
-                for (i, l) in lam.iter().enumerate() {
-                    let v = tb.rgb(o, i);
-                    t.data[o * ni + i] = [v[0] * l, v[1] * l, v[2] * l];
-                }
-            }
-            return Ok(t);
+            return Ok(tb.weighted_matrix());
         }
         tb_lamb = Some(lamb);
     }
@@ -818,16 +823,7 @@ pub fn reflection_matrix_with(
     let Some(r) = take(&mut encode_all(b, rng), d)? else {
         return Ok(None);
     };
-    let (ni, no) = (r.y.incident.len(), r.y.outgoing.len());
-    let lam = r.y.incident.lambdas();
-    let mut m = RgbMatrix::zeros(no, ni);
-    for o in 0..no {
-        for (i, l) in lam.iter().enumerate() {
-            let v = r.rgb(o, i);
-            m.data[o * ni + i] = [v[0] * l, v[1] * l, v[2] * l];
-        }
-    }
-    Ok(Some(m))
+    Ok(Some(r.weighted_matrix()))
 }
 
 #[cfg(test)]

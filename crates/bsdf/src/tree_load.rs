@@ -431,13 +431,7 @@ pub(crate) fn visit_leaves(
         Node::Branch(ch) => {
             let half = 0.5 * csiz;
             for (n, c) in ch.iter().enumerate() {
-                let mut lo = *cmin;
-                for (i, l) in lo.iter_mut().enumerate().take(r) {
-                    if n >> i & 1 == 1 {
-                        *l += half;
-                    }
-                }
-                visit_leaves(c, r, &lo, half, f);
+                visit_leaves(c, r, &child_corner(cmin, r, n, half), half, f);
             }
         }
         Node::Grid { log2, values } => {
@@ -450,8 +444,22 @@ pub(crate) fn visit_leaves(
     }
 }
 
+/// Lower corner of child `n` (of a branch of rank `r`, corner `cmin`, half edge `half`):
+/// bit `i` of `n` set puts the child in the upper half of dimension `i`.
+#[inline]
+pub(crate) fn child_corner(cmin: &[f64; 4], r: usize, n: usize, half: f64) -> [f64; 4] {
+    let mut lo = *cmin;
+    for (i, l) in lo.iter_mut().enumerate().take(r) {
+        if n >> i & 1 == 1 {
+            *l += half;
+        }
+    }
+    lo
+}
+
 /// Lower corner of cell `k` (dimension 0 slowest) of a grid of `cells` per dimension and cell
 /// edge `cell` whose corner is `cmin`.
+#[inline]
 pub(crate) fn cell_corner(
     cmin: &[f64; 4],
     r: usize,
@@ -480,13 +488,7 @@ pub(crate) fn map_leaves(
             let half = 0.5 * csiz;
             let mut out = Vec::with_capacity(ch.len());
             for (n, c) in ch.iter().enumerate() {
-                let mut lo = *cmin;
-                for (i, l) in lo.iter_mut().enumerate().take(r) {
-                    if n >> i & 1 == 1 {
-                        *l += half;
-                    }
-                }
-                out.push(map_leaves(c, r, &lo, half, f));
+                out.push(map_leaves(c, r, &child_corner(cmin, r, n, half), half, f));
             }
             Node::Branch(out)
         }

@@ -13,7 +13,7 @@ use std::sync::{Arc, Mutex};
 use crate::check::sampled::TreeFile;
 use crate::model::Bsdf;
 use crate::tree::{disk_to_square, leaf_at, smallest_leaf_edge, square_to_disk, Node};
-use crate::tree_load::{leaf_value, orient, position, spin_z, Side};
+use crate::tree_load::{cell_corner, child_corner, leaf_value, orient, position, spin_z, Side};
 
 /// A lobe of a BSDF seen from one side.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -324,12 +324,7 @@ fn slice_leaves(
         Node::Branch(ch) => {
             let half = 0.5 * csiz;
             for (n, c) in ch.iter().enumerate() {
-                let mut lo = *cmin;
-                for (i, l) in lo.iter_mut().enumerate().take(rank) {
-                    if n >> i & 1 == 1 {
-                        *l += half;
-                    }
-                }
+                let lo = child_corner(cmin, rank, n, half);
                 if inside(&lo, half) {
                     slice_leaves(c, rank, mask, fixed, &lo, half, f);
                 }
@@ -339,11 +334,7 @@ fn slice_leaves(
             let cells = 1usize << log2;
             let cell = csiz / cells as f64;
             for (k, &val) in values.iter().enumerate() {
-                let mut lo = *cmin;
-                for (i, l) in lo.iter_mut().enumerate().take(rank) {
-                    let ci = k / cells.pow((rank - 1 - i) as u32) % cells;
-                    *l += cell * ci as f64;
-                }
+                let lo = cell_corner(cmin, rank, cells, cell, k);
                 if inside(&lo, cell) {
                     f(val, &lo, cell);
                 }

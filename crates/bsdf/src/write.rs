@@ -4,7 +4,7 @@
 use std::fmt::Write;
 
 use crate::klems::KlemsBasis;
-use crate::model::{BlockData, Bsdf, DataStructure, Wavelength};
+use crate::model::{Block, BlockData, Bsdf, DataStructure, Wavelength};
 
 /// Why a BSDF cannot be written as Klems XML.
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -22,6 +22,38 @@ fn escape(s: &str) -> String {
         .replace('<', "&lt;")
         .replace('>', "&gt;")
 }
+
+/// The detector spectrum of a block of wavelength `w` (Y but for the X and Z blocks).
+fn detector_spectrum(w: &Wavelength) -> &'static str {
+    match w {
+        Wavelength::CieX => "ASTM E308 1931 X.dsp",
+        Wavelength::CieZ => "ASTM E308 1931 Z.dsp",
+        _ => "ASTM E308 1931 Y.dsp",
+    }
+}
+
+/// Opens the `WavelengthData` of block `blk` through its `<ScatteringData>` line: `detector`
+/// names its detector spectrum (None: no such line) and `bases` holds its angle-basis lines.
+fn open_block(out: &mut String, blk: &Block, detector: Option<&str>, bases: &str) {
+    let _ = write!(
+        out,
+        "\t<WavelengthData>\n\t\t<LayerNumber>System</LayerNumber>\n\t\t<Wavelength unit=\"Integral\">{}</Wavelength>\n\t\t<SourceSpectrum>CIE Illuminant D65 1nm.ssp</SourceSpectrum>\n",
+        escape(blk.wavelength.xml_name())
+    );
+    if let Some(d) = detector {
+        let _ = writeln!(out, "\t\t<DetectorSpectrum>{d}</DetectorSpectrum>");
+    }
+    let _ = writeln!(
+        out,
+        "\t\t<WavelengthDataBlock>\n\t\t\t<WavelengthDataDirection>{}</WavelengthDataDirection>\n{bases}\t\t\t<ScatteringDataType>{}</ScatteringDataType>\n\t\t\t<ScatteringData>",
+        blk.direction.xml_name(),
+        if blk.data_type.is_empty() { "BTDF" } else { &blk.data_type }
+    );
+}
+
+/// Closes a block [`open_block`] opened, after its data.
+const CLOSE_BLOCK: &str =
+    "\t\t\t</ScatteringData>\n\t\t</WavelengthDataBlock>\n\t</WavelengthData>\n";
 
 fn basis_xml(out: &mut String, b: &KlemsBasis) {
     let _ = writeln!(
@@ -101,24 +133,15 @@ pub fn klems_xml(b: &Bsdf, comment: Option<&str>) -> Result<String, WriteError> 
             let BlockData::Tree(t) = &blk.data else {
                 return Err(WriteError::Mixed(k));
             };
-            let _ = write!(
-                out,
-                "\t<WavelengthData>\n\t\t<LayerNumber>System</LayerNumber>\n\t\t<Wavelength unit=\"Integral\">{}</Wavelength>\n\t\t<SourceSpectrum>CIE Illuminant D65 1nm.ssp</SourceSpectrum>\n{}\t\t<WavelengthDataBlock>\n\t\t\t<WavelengthDataDirection>{}</WavelengthDataDirection>\n\t\t\t<AngleBasis>LBNL/Shirley-Chiu</AngleBasis>\n\t\t\t<ScatteringDataType>{}</ScatteringDataType>\n\t\t\t<ScatteringData>\n",
-                escape(blk.wavelength.xml_name()),
-                // wrapBSDF writes no detector for the u′ and v′ trees
-                match blk.wavelength {
-                    Wavelength::CieX => "\t\t<DetectorSpectrum>ASTM E308 1931 X.dsp</DetectorSpectrum>\n",
-                    Wavelength::CieZ => "\t\t<DetectorSpectrum>ASTM E308 1931 Z.dsp</DetectorSpectrum>\n",
-                    Wavelength::CieU | Wavelength::CieV => "",
-                    _ => "\t\t<DetectorSpectrum>ASTM E308 1931 Y.dsp</DetectorSpectrum>\n",
-                },
-                blk.direction.xml_name(),
-                if blk.data_type.is_empty() { "BTDF" } else { &blk.data_type },
-            );
+            // wrapBSDF writes no detector for the u′ and v′ trees
+            let detector = match blk.wavelength {
+                Wavelength::CieU | Wavelength::CieV => None,
+                _ => Some(detector_spectrum(&blk.wavelength)),
+            };
+            let bases = "\t\t\t<AngleBasis>LBNL/Shirley-Chiu</AngleBasis>\n";
+            open_block(&mut out, blk, detector, bases);
             t.write_text(&mut out);
-            out.push_str(
-                "\t\t\t</ScatteringData>\n\t\t</WavelengthDataBlock>\n\t</WavelengthData>\n",
-            );
+            out.push_str(CLOSE_BLOCK);
         }
         out.push_str("</Layer>\n</Optical>\n</WindowElement>\n");
         return Ok(out);
@@ -145,20 +168,13 @@ pub fn klems_xml(b: &Bsdf, comment: Option<&str>) -> Result<String, WriteError> 
         let BlockData::Klems(m) = &blk.data else {
             continue;
         };
-        let _ = writeln!(
-            out,
-            "\t<WavelengthData>\n\t\t<LayerNumber>System</LayerNumber>\n\t\t<Wavelength unit=\"Integral\">{}</Wavelength>\n\t\t<SourceSpectrum>CIE Illuminant D65 1nm.ssp</SourceSpectrum>\n\t\t<DetectorSpectrum>{}</DetectorSpectrum>\n\t\t<WavelengthDataBlock>\n\t\t\t<WavelengthDataDirection>{}</WavelengthDataDirection>\n\t\t\t<ColumnAngleBasis>{}</ColumnAngleBasis>\n\t\t\t<RowAngleBasis>{}</RowAngleBasis>\n\t\t\t<ScatteringDataType>{}</ScatteringDataType>\n\t\t\t<ScatteringData>",
-            escape(blk.wavelength.xml_name()),
-            match blk.wavelength {
-                Wavelength::CieX => "ASTM E308 1931 X.dsp",
-                Wavelength::CieZ => "ASTM E308 1931 Z.dsp",
-                _ => "ASTM E308 1931 Y.dsp",
-            },
-            blk.direction.xml_name(),
+        let bases = format!(
+            "\t\t\t<ColumnAngleBasis>{}</ColumnAngleBasis>\n\t\t\t<RowAngleBasis>{}</RowAngleBasis>\n",
             escape(m.incident.name()),
             escape(m.outgoing.name()),
-            if blk.data_type.is_empty() { "BTDF" } else { &blk.data_type }
         );
+        let detector = detector_spectrum(&blk.wavelength);
+        open_block(&mut out, blk, Some(detector), &bases);
         let ni = m.incident.len();
         for row in m.values.chunks(ni) {
             for v in row {
@@ -166,7 +182,7 @@ pub fn klems_xml(b: &Bsdf, comment: Option<&str>) -> Result<String, WriteError> 
             }
             out.push('\n');
         }
-        out.push_str("\t\t\t</ScatteringData>\n\t\t</WavelengthDataBlock>\n\t</WavelengthData>\n");
+        out.push_str(CLOSE_BLOCK);
     }
     out.push_str("</Layer>\n</Optical>\n</WindowElement>\n");
     Ok(out)

@@ -226,56 +226,56 @@ pub struct Extras {
 pub fn lookup(name: &str, extras: Extras) -> Option<(Builtin, usize)> {
     use Builtin as B;
     use Math1 as M;
-    let core = match name {
-        "if" => Some((B::If, 3)),
-        "select" => Some((B::Select, 1)),
-        "sqrt" => Some((B::Math1(M::Sqrt), 1)),
-        "sin" => Some((B::Math1(M::Sin), 1)),
-        "cos" => Some((B::Math1(M::Cos), 1)),
-        "tan" => Some((B::Math1(M::Tan), 1)),
-        "asin" => Some((B::Math1(M::Asin), 1)),
-        "acos" => Some((B::Math1(M::Acos), 1)),
-        "atan" => Some((B::Math1(M::Atan), 1)),
-        "atan2" => Some((B::Atan2, 2)),
-        "exp" => Some((B::Math1(M::Exp), 1)),
-        "log" => Some((B::Math1(M::Log), 1)),
-        "log10" => Some((B::Math1(M::Log10), 1)),
-        "floor" => Some((B::Math1(M::Floor), 1)),
-        "ceil" => Some((B::Math1(M::Ceil), 1)),
-        "rand" => Some((B::Rand, 1)),
-        "max" => Some((B::Max, 1)),
-        "min" => Some((B::Min, 1)),
-        _ => None,
+    let math = [
+        M::Sqrt,
+        M::Sin,
+        M::Cos,
+        M::Tan,
+        M::Asin,
+        M::Acos,
+        M::Atan,
+        M::Exp,
+        M::Log,
+        M::Log10,
+        M::Floor,
+        M::Ceil,
+        M::J0,
+        M::J1,
+        M::Y0,
+        M::Y1,
+        M::Erf,
+        M::Erfc,
+    ];
+    let other = [
+        B::If,
+        B::Select,
+        B::Atan2,
+        B::Rand,
+        B::Max,
+        B::Min,
+        B::In,
+        B::Jn,
+        B::Yn,
+        B::Arg,
+    ];
+    let b = other
+        .into_iter()
+        .chain(math.map(B::Math1))
+        .find(|b| b.name() == name)?;
+    let enabled = match b {
+        // rcalc/ev additions
+        B::In | B::Jn | B::Yn | B::Math1(M::J0 | M::J1 | M::Y0 | M::Y1) => extras.rcalc,
+        B::Math1(M::Erf | M::Erfc) => extras.rcalc || extras.render,
+        // renderer additions
+        B::Arg => extras.render,
+        _ => true,
     };
-    if core.is_some() {
-        return core;
-    }
-    if extras.rcalc {
-        let r = match name {
-            "in" => Some((B::In, 1)),
-            "j0" => Some((B::Math1(M::J0), 1)),
-            "j1" => Some((B::Math1(M::J1), 1)),
-            "y0" => Some((B::Math1(M::Y0), 1)),
-            "y1" => Some((B::Math1(M::Y1), 1)),
-            "jn" => Some((B::Jn, 2)),
-            "yn" => Some((B::Yn, 2)),
-            _ => None,
-        };
-        if r.is_some() {
-            return r;
-        }
-    }
-    if extras.rcalc || extras.render {
-        match name {
-            "erf" => return Some((B::Math1(M::Erf), 1)),
-            "erfc" => return Some((B::Math1(M::Erfc), 1)),
-            _ => {}
-        }
-    }
-    if extras.render && name == "arg" {
-        return Some((B::Arg, 1));
-    }
-    None
+    let min_args = match b {
+        B::If => 3,
+        B::Atan2 | B::Jn | B::Yn => 2,
+        _ => 1,
+    };
+    enabled.then_some((b, min_args))
 }
 
 #[cfg(test)]

@@ -126,16 +126,19 @@ impl Program {
         }
     }
 
+    /// A syntax error with `message` at `pos`.
+    fn syntax_error(&self, message: String, pos: Pos) -> CalcError {
+        CalcError::at(
+            ErrorKind::Syntax,
+            message,
+            Self::location(&self.sources, pos),
+        )
+    }
+
     /// Loads definitions from text; `name` labels it in messages (a file name, or `-e`).
     pub fn load_str(&mut self, name: &str, text: &str) -> Result<(), CalcError> {
         let src = self.add_source(name, text);
-        let defs = parse_defs(text, src).map_err(|e| {
-            CalcError::at(
-                ErrorKind::Syntax,
-                e.message,
-                Self::location(&self.sources, e.pos),
-            )
-        })?;
+        let defs = parse_defs(text, src).map_err(|e| self.syntax_error(e.message, e.pos))?;
         for mut d in defs {
             if !self.no_parse_constants {
                 if let Err(r) = crate::lit::fold(&mut d.body, self.extras, &self.defs) {
@@ -143,11 +146,7 @@ impl Program {
                         crate::lit::Refused::BadConstant => "bad constant expression",
                         crate::lit::Refused::DivideByZero => "divide by zero constant",
                     };
-                    return Err(CalcError::at(
-                        ErrorKind::Syntax,
-                        msg.to_string(),
-                        Self::location(&self.sources, d.pos),
-                    ));
+                    return Err(self.syntax_error(msg.to_string(), d.pos));
                 }
             }
             self.define(d);
@@ -247,13 +246,7 @@ impl Program {
     /// compiled with the program; evaluate it with [`crate::Compiled::eval_expr`].
     pub fn add_expr(&mut self, label: &str, text: &str) -> Result<ExprId, CalcError> {
         let src = self.add_source(label, text);
-        let e = parse_expr(text, src).map_err(|e| {
-            CalcError::at(
-                ErrorKind::Syntax,
-                e.message,
-                Self::location(&self.sources, e.pos),
-            )
-        })?;
+        let e = parse_expr(text, src).map_err(|e| self.syntax_error(e.message, e.pos))?;
         self.exprs.push(e);
         Ok(ExprId((self.exprs.len() - 1) as u32))
     }

@@ -150,6 +150,16 @@ impl OptHit {
         }
     }
 
+    /// The integer value when it is positive; otherwise an error with the message `msg`
+    /// makes of the value.
+    pub fn positive_int(&self, msg: impl FnOnce(i64) -> String) -> Result<i64> {
+        let v = self.int();
+        if v <= 0 {
+            bail!("{}", msg(v));
+        }
+        Ok(v)
+    }
+
     /// Real value (0 when the option is not numeric).
     pub fn real(&self) -> f64 {
         match self.value {
@@ -243,6 +253,13 @@ impl Spec {
     /// Adds an option.
     pub fn opt(mut self, o: Opt) -> Self {
         self.opts.push(o);
+        self
+    }
+
+    /// Adds several options in order: a tool's option table, or a shared group such as the
+    /// view options.
+    pub fn opts(mut self, table: impl IntoIterator<Item = Opt>) -> Self {
+        self.opts.extend(table);
         self
     }
 
@@ -345,6 +362,20 @@ impl Spec {
             }));
         }
         Ok(items)
+    }
+
+    /// [`Spec::parse`] with the options and the positional words returned apart, each in
+    /// command-line order (for tools that do not apply options to the file that follows).
+    pub fn parse_apart(&self, args: &[String]) -> Result<(Vec<OptHit>, Vec<String>)> {
+        let mut hits = Vec::new();
+        let mut words = Vec::new();
+        for item in self.parse(args)? {
+            match item {
+                Item::Opt(hit) => hits.push(hit),
+                Item::Pos(word) => words.push(word),
+            }
+        }
+        Ok((hits, words))
     }
 
     /// The longest declared name that prefixes `body` and accepts what follows it;
@@ -583,6 +614,35 @@ mod tests {
         let items = spec.parse(&s(&["t", "-s", "-2.5", "-3"])).unwrap();
         assert!(matches!(&items[0], Item::Opt(o) if o.real() == -2.5));
         assert_eq!(items[1], Item::Pos("-3".into()));
+    }
+
+    #[test]
+    fn option_tables_and_positive_integers() {
+        let spec = Spec::new("t", "t").opts([
+            Opt::new("n", Kind::Int, "count"),
+            Opt::new("h", Kind::Flag, "header"),
+        ]);
+        assert_eq!(spec.options().len(), 2);
+        let items = spec.parse(&s(&["t", "-n", "3", "-n", "0"])).unwrap();
+        let msg = |v: i64| format!("-n {v}: must be positive");
+        let Item::Opt(three) = &items[0] else {
+            panic!()
+        };
+        assert_eq!(three.positive_int(msg).unwrap(), 3);
+        let Item::Opt(zero) = &items[1] else { panic!() };
+        let e = zero.positive_int(msg).unwrap_err().to_string();
+        assert_eq!(e, "-n 0: must be positive");
+    }
+
+    #[test]
+    fn options_and_words_apart() {
+        let spec = Spec::new("t", "t")
+            .interleaved(true)
+            .opt(Opt::new("c", Kind::Int, "count"));
+        let (hits, words) = spec.parse_apart(&s(&["t", "a", "-c", "2", "b"])).unwrap();
+        assert_eq!(hits.len(), 1);
+        assert_eq!((hits[0].key, hits[0].int()), ("c", 2));
+        assert_eq!(words, s(&["a", "b"]));
     }
 
     #[test]

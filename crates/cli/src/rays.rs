@@ -14,6 +14,16 @@ use anyhow::Result;
 
 pub use fenestra_io::numfmt::RayFormat;
 
+/// The format a whole `-f` suffix names (`a`, `f` or `d`, one letter alone); `None` for
+/// anything else.
+pub fn format_suffix(w: &str) -> Option<RayFormat> {
+    let mut c = w.chars();
+    match (c.next().and_then(RayFormat::from_letter), c.next()) {
+        (Some(f), None) => Some(f),
+        _ => None,
+    }
+}
+
 /// One input ray: origin (or point) and direction (or normal).
 pub type Ray = ([f64; 3], [f64; 3]);
 

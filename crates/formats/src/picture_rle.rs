@@ -113,7 +113,7 @@ fn read_old(r: &mut impl Read, scan: &mut [Rgbe], start: usize) -> Result<(), Sc
     let mut shift = 0u32;
     while j < len {
         let p = pixel(r)?;
-        if p[0] == 1 && p[1] == 1 && p[2] == 1 {
+        let repeat = if p[0] == 1 && p[1] == 1 && p[2] == 1 {
             if j == 0 {
                 return Err(ScanError::Corrupt(
                     "repeat marker with no previous pixel".to_string(),
@@ -129,19 +129,37 @@ fn read_old(r: &mut impl Read, scan: &mut [Rgbe], start: usize) -> Result<(), Sc
                     "repeat of {cnt} at pixel {j} overruns scanline of {len}"
                 )));
             }
-            let prev = scan[j - 1];
-            for q in &mut scan[j..j + cnt] {
-                *q = prev;
-            }
-            j += cnt;
-            shift += 8;
+            Some(cnt)
         } else {
-            scan[j] = p;
-            j += 1;
-            shift = 0;
-        }
+            None
+        };
+        (j, shift) = flat_step(scan, j, shift, p, repeat);
     }
     Ok(())
+}
+
+/// One step of decoding flat pixels at position `j` of `scan` with repeat shift `shift`:
+/// for an old-style `(1,1,1,n)` marker (`repeat`, its checked count) the previous pixel
+/// that many times, else pixel `p`. Returns the new position and shift.
+#[inline]
+pub(crate) fn flat_step(
+    scan: &mut [Rgbe],
+    j: usize,
+    shift: u32,
+    p: Rgbe,
+    repeat: Option<usize>,
+) -> (usize, u32) {
+    match repeat {
+        Some(count) => {
+            let prev = scan[j - 1];
+            scan[j..j + count].fill(prev);
+            (j + count, shift + 8)
+        }
+        None => {
+            scan[j] = p;
+            (j + 1, 0)
+        }
+    }
 }
 
 /// Writes one scanline: new run-length encoding for 17..=32767 pixels, flat otherwise

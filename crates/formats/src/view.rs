@@ -180,46 +180,30 @@ impl View {
         if !tail.is_empty() {
             return Err(format!("unknown view option '{opt}'"));
         }
-        match c {
-            'p' => {
-                self.vp = vec3()?;
-                Ok(3)
-            }
-            'd' => {
-                self.vdir = vec3()?;
+        let vector = match c {
+            'p' => Some(&mut self.vp),
+            'd' => Some(&mut self.vdir),
+            'u' => Some(&mut self.vup),
+            _ => None,
+        };
+        if let Some(v) = vector {
+            *v = vec3()?;
+            if c == 'd' {
                 self.vdist = 1.0;
-                Ok(3)
             }
-            'u' => {
-                self.vup = vec3()?;
-                Ok(3)
-            }
-            'h' => {
-                self.horiz = num(1)?;
-                Ok(1)
-            }
-            'v' => {
-                self.vert = num(1)?;
-                Ok(1)
-            }
-            'o' => {
-                self.vfore = num(1)?;
-                Ok(1)
-            }
-            'a' => {
-                self.vaft = num(1)?;
-                Ok(1)
-            }
-            's' => {
-                self.hoff = num(1)?;
-                Ok(1)
-            }
-            'l' => {
-                self.voff = num(1)?;
-                Ok(1)
-            }
-            _ => Err(format!("unknown view option '{opt}'")),
+            return Ok(3);
         }
+        let scalar = match c {
+            'h' => &mut self.horiz,
+            'v' => &mut self.vert,
+            'o' => &mut self.vfore,
+            'a' => &mut self.vaft,
+            's' => &mut self.hoff,
+            'l' => &mut self.voff,
+            _ => return Err(format!("unknown view option '{opt}'")),
+        };
+        *scalar = num(1)?;
+        Ok(1)
     }
 
     /// Applies every view option found in a line (a `VIEW=` line, or a command line such

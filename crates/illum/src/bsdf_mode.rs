@@ -11,12 +11,11 @@ use std::sync::Arc;
 use anyhow::{bail, Context, Result};
 use fenestra_bsdf::klems::Frame;
 use fenestra_bsdf::KlemsBasis;
-use fenestra_trace::rng::spread2;
 use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::geometry::Face;
-use crate::sample::{Distribution, Job};
+use crate::sample::{stratified2, Distribution, Job};
 
 /// Grid of the written distribution: altitude rows (uniform in sin²θ) and azimuth columns.
 pub const GRID: (usize, usize) = (45, 72);
@@ -129,11 +128,8 @@ pub fn face(
     let rays: Vec<Option<(usize, [f64; 3])>> = (0..ni * s)
         .into_par_iter()
         .map(|idx| {
-            let (i, k) = (idx / s, idx % s);
-            let (mut rng, id) = job.stream(idx as u64);
-            job.tick(1);
-            let t = (k as f64 + rng.next_f64()) / s as f64;
-            let (s0, s1) = spread2(t, &mut rng);
+            let (i, k, mut rng, id) = job.start_ray(idx);
+            let (s0, s1) = stratified2(k, s, &mut rng);
             let l = bsdf.incident.sample_projected(i, s0, s1)?;
             let dir = -(l[0] * u + l[1] * v + l[2] * n);
             let org = point(&mut rng)?;
@@ -159,8 +155,7 @@ pub fn face(
         .into_par_iter()
         .map(|k| {
             let (mut rng, id) = job.stream((ni * s + k) as u64);
-            let t = (k as f64 + rng.next_f64()) / npts as f64;
-            let (a0, b0) = spread2(t, &mut rng);
+            let (a0, b0) = stratified2(k, npts, &mut rng);
             let (a, b) = (
                 f.ur[0] + (f.ur[1] - f.ur[0]) * a0,
                 f.vr[0] + (f.vr[1] - f.vr[0]) * b0,

@@ -257,24 +257,14 @@ impl Settings {
                 }
                 _ => false,
             },
-            b'l' => match w.as_bytes().get(1) {
-                Some(b'+') => {
-                    self.light = true;
-                    w.len() == 2
-                }
-                Some(b'-') => {
-                    self.light = false;
-                    w.len() == 2
-                }
-                _ => false,
-            },
-            b'p' => match w.as_bytes().get(1) {
-                Some(b'+') => {
-                    self.refine = true;
-                    w.len() == 2
-                }
-                Some(b'-') => {
-                    self.refine = false;
+            b'l' | b'p' => match w.as_bytes().get(1) {
+                Some(b'+' | b'-') => {
+                    let flag = if w.starts_with('l') {
+                        &mut self.light
+                    } else {
+                        &mut self.refine
+                    };
+                    *flag = w.as_bytes()[1] == b'+';
                     w.len() == 2
                 }
                 _ => false,

@@ -392,46 +392,37 @@ impl<'a> Filter<'a> {
         out: &mut String,
         job: &Job,
     ) -> Result<Option<(crate::sample::Distribution, Option<[glam::DVec3; 3]>)>> {
-        Ok(Some(match p.ptype.as_str() {
+        // the distribution, or why the surface is passed on unchanged
+        let sampled = match p.ptype.as_str() {
             "polygon" => {
                 let Some(face) = self.face_of(p, name, out)? else {
                     return Ok(None);
                 };
-                match sample::face(job, &face) {
-                    Some(d) => (d, Some([face.u, face.v, face.norm])),
-                    None => {
-                        self.pass_unchanged(
-                            p,
-                            out,
-                            &format!("polygon \"{}\": bad aspect", p.name),
-                            name,
-                        );
-                        return Ok(None);
-                    }
-                }
+                sample::face(job, &face)
+                    .map(|d| (d, Some([face.u, face.v, face.norm])))
+                    .ok_or_else(|| format!("polygon \"{}\": bad aspect", p.name))
             }
             "ring" => {
                 let r = Ring::new(&p.rargs)
                     .map_err(|e| anyhow::anyhow!("({name}): ring \"{}\": {e}", p.name))?;
-                (sample::ring(job, &r), Some([r.u, r.v, r.axis]))
+                Ok((sample::ring(job, &r), Some([r.u, r.v, r.axis])))
             }
             "sphere" => {
                 if p.rargs.len() != 4 {
                     bail!("({name}): sphere \"{}\": bad # of arguments", p.name);
                 }
                 let c = glam::DVec3::new(p.rargs[0], p.rargs[1], p.rargs[2]);
-                (sample::sphere(job, c, p.rargs[3]), None)
+                Ok((sample::sphere(job, c, p.rargs[3]), None))
             }
-            other => {
-                self.pass_unchanged(
-                    p,
-                    out,
-                    &format!("cannot make illum for {other} \"{}\"", p.name),
-                    name,
-                );
-                return Ok(None);
+            other => Err(format!("cannot make illum for {other} \"{}\"", p.name)),
+        };
+        match sampled {
+            Ok(s) => Ok(Some(s)),
+            Err(why) => {
+                self.pass_unchanged(p, out, &why, name);
+                Ok(None)
             }
-        }))
+        }
     }
 
     /// BSDF-data mode (`d=file.xml`) for one surface.

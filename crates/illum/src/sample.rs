@@ -134,6 +134,13 @@ pub fn flatindex(dv: DVec3, nalt: usize, nazi: usize) -> usize {
     i * nazi + j
 }
 
+/// Two numbers in [0, 1) for sample `i` of `s`: the first stratified (drawn in the
+/// sample's 1/`s` of the range), both then spread by [`spread2`].
+pub(crate) fn stratified2(i: usize, s: usize, rng: &mut Rng) -> (f64, f64) {
+    let t = (i as f64 + rng.next_f64()) / s as f64;
+    spread2(t, rng)
+}
+
 /// What the sampler needs besides the surface.
 pub struct Job<'a> {
     /// The tracer.
@@ -162,6 +169,14 @@ impl Job<'_> {
         }
     }
 
+    /// Starts ray `idx` of this surface (counted on the progress bar): its bin (of
+    /// `nsamps` rays each), its index in the bin, its sampling stream and tracer ray index.
+    pub(crate) fn start_ray(&self, idx: usize) -> (usize, usize, Rng, u64) {
+        let (rng, id) = self.stream(idx as u64);
+        self.tick(1);
+        (idx / self.nsamps, idx % self.nsamps, rng, id)
+    }
+
     /// The sampling stream and tracer ray index of ray `index` of this surface.
     pub fn stream(&self, index: u64) -> (Rng, u64) {
         let id = (self.surface << 36) | index;
@@ -170,8 +185,7 @@ impl Job<'_> {
 
     /// Direction of sample `i` of bin `k` in local coordinates (toward the normal).
     fn local_dir(&self, k: usize, i: usize, rng: &mut Rng) -> DVec3 {
-        let t = (i as f64 + rng.next_f64()) / self.nsamps as f64;
-        let (s0, s1) = spread2(t, rng);
+        let (s0, s1) = stratified2(i, self.nsamps, rng);
         let alti = k / self.nazi;
         let r1 = (alti as f64 + s0) / self.nalt as f64;
         let r2 = ((k - alti * self.nazi) as f64 + s1 - 0.5) / self.nazi as f64;
@@ -215,9 +229,7 @@ pub fn face(job: &Job, f: &Face) -> Option<Distribution> {
     let rays: Vec<(usize, [f64; 3], usize)> = (0..n * s)
         .into_par_iter()
         .map(|idx| {
-            let (k, i) = (idx / s, idx % s);
-            let (mut rng, id) = job.stream(idx as u64);
-            job.tick(1);
+            let (k, i, mut rng, id) = job.start_ray(idx);
             let dn = job.local_dir(k, i, &mut rng);
             let dir = -(dn.x * f.u + dn.y * f.v + dn.z * f.norm);
             let (org, fails) = origin(&mut rng);
@@ -258,9 +270,7 @@ pub fn ring(job: &Job, r: &Ring) -> Distribution {
     let rays: Vec<(usize, [f64; 3])> = (0..n * s)
         .into_par_iter()
         .map(|idx| {
-            let (k, i) = (idx / s, idx % s);
-            let (mut rng, id) = job.stream(idx as u64);
-            job.tick(1);
+            let (k, i, mut rng, id) = job.start_ray(idx);
             let dn = job.local_dir(k, i, &mut rng);
             let dir = -(dn.x * r.u + dn.y * r.v + dn.z * r.axis);
             let org = r.point(rng.next_f64(), rng.next_f64()) + eps * r.axis;
@@ -288,11 +298,8 @@ pub fn sphere(job: &Job, centre: DVec3, radius: f64) -> Distribution {
     let rays: Vec<(usize, [f64; 3])> = (0..n * s)
         .into_par_iter()
         .map(|idx| {
-            let (k, i) = (idx / s, idx % s);
-            let (mut rng, id) = job.stream(idx as u64);
-            job.tick(1);
-            let t = (i as f64 + rng.next_f64()) / s as f64;
-            let (s0, s1) = spread2(t, &mut rng);
+            let (k, i, mut rng, id) = job.start_ray(idx);
+            let (s0, s1) = stratified2(i, s, &mut rng);
             let (a, z) = (k / job.nazi, k % job.nazi);
             let out = rounddir(
                 (a as f64 + s0) / job.nalt as f64,

@@ -226,6 +226,42 @@ struct State {
     out: Vec<Primitive>,
 }
 
+/// A context entity line (`v`, `c` or `m`) over `table`, the defined entries of `kind`:
+/// `x name` selects an entry, `x name =` defines it as `fresh()` and `x name = template`
+/// as a copy of another. Returns the new current entry's name, None for a bare `x` (the
+/// unnamed entry); `usage` lists the accepted forms for the error.
+fn context_entry<T: Clone>(
+    l: &Line,
+    table: &mut HashMap<String, T>,
+    kind: &str,
+    fresh: impl FnOnce() -> T,
+    usage: &str,
+) -> Result<Option<String>> {
+    let w = &l.words;
+    match w.len() {
+        1 => Ok(None),
+        2 => {
+            if !table.contains_key(&w[1]) {
+                bail!("{}: undefined {kind} '{}'", l.loc, w[1]);
+            }
+            Ok(Some(w[1].clone()))
+        }
+        3 | 4 if w[2] == "=" => {
+            let v = if w.len() == 4 {
+                table
+                    .get(&w[3])
+                    .cloned()
+                    .ok_or_else(|| anyhow!("{}: undefined {kind} template '{}'", l.loc, w[3]))?
+            } else {
+                fresh()
+            };
+            table.insert(w[1].clone(), v);
+            Ok(Some(w[1].clone()))
+        }
+        _ => bail!("{}: expected {usage}", l.loc),
+    }
+}
+
 fn num(l: &Line, k: usize, what: &str) -> Result<f64> {
     let w = l
         .words
@@ -540,96 +576,26 @@ impl State {
     }
 
     fn context_vertex(&mut self, l: &Line) -> Result<()> {
-        let w = &l.words;
-        match w.len() {
-            1 => self.cur_vertex = None,
-            2 => {
-                if !self.vertices.contains_key(&w[1]) {
-                    bail!("{}: undefined vertex '{}'", l.loc, w[1]);
-                }
-                self.cur_vertex = Some(w[1].clone());
-            }
-            3 | 4 if w[2] == "=" => {
-                let v = if w.len() == 4 {
-                    *self
-                        .vertices
-                        .get(&w[3])
-                        .ok_or_else(|| anyhow!("{}: undefined vertex template '{}'", l.loc, w[3]))?
-                } else {
-                    Vertex::default()
-                };
-                self.vertices.insert(w[1].clone(), v);
-                self.cur_vertex = Some(w[1].clone());
-            }
-            _ => bail!(
-                "{}: expected 'v name', 'v name =' or 'v name = template'",
-                l.loc
-            ),
-        }
+        let usage = "'v name', 'v name =' or 'v name = template'";
+        self.cur_vertex = context_entry(l, &mut self.vertices, "vertex", Vertex::default, usage)?;
         Ok(())
     }
 
     fn context_colour(&mut self, l: &Line) -> Result<()> {
-        let w = &l.words;
-        match w.len() {
-            1 => {
-                self.cur_colour = None;
-                self.unnamed_colour = None;
-            }
-            2 => {
-                if !self.colours.contains_key(&w[1]) {
-                    bail!("{}: undefined colour '{}'", l.loc, w[1]);
-                }
-                self.cur_colour = Some(w[1].clone());
-            }
-            3 | 4 if w[2] == "=" => {
-                let c = if w.len() == 4 {
-                    *self
-                        .colours
-                        .get(&w[3])
-                        .ok_or_else(|| anyhow!("{}: undefined colour template '{}'", l.loc, w[3]))?
-                } else {
-                    NEUTRAL
-                };
-                self.colours.insert(w[1].clone(), c);
-                self.cur_colour = Some(w[1].clone());
-            }
-            _ => bail!(
-                "{}: expected 'c', 'c name', 'c name =' or 'c name = template'",
-                l.loc
-            ),
+        let usage = "'c', 'c name', 'c name =' or 'c name = template'";
+        self.cur_colour = context_entry(l, &mut self.colours, "colour", || NEUTRAL, usage)?;
+        if self.cur_colour.is_none() {
+            self.unnamed_colour = None;
         }
         Ok(())
     }
 
     fn context_material(&mut self, l: &Line) -> Result<()> {
-        let w = &l.words;
-        match w.len() {
-            1 => {
-                self.cur_material = None;
-                self.unnamed_material = Material::default();
-            }
-            2 => {
-                if !self.materials.contains_key(&w[1]) {
-                    bail!("{}: undefined material '{}'", l.loc, w[1]);
-                }
-                self.cur_material = Some(w[1].clone());
-            }
-            3 | 4 if w[2] == "=" => {
-                let m = if w.len() == 4 {
-                    self.materials.get(&w[3]).cloned().ok_or_else(|| {
-                        anyhow!("{}: undefined material template '{}'", l.loc, w[3])
-                    })?
-                } else {
-                    Material::default()
-                };
-                self.materials.insert(w[1].clone(), m);
-                self.cur_material = Some(w[1].clone());
-            }
-            _ => bail!(
-                "{}: expected 'm', 'm name', 'm name =' or 'm name = template'",
-                l.loc
-            ),
+        let usage = "'m', 'm name', 'm name =' or 'm name = template'";
+        let table = &mut self.materials;
+        self.cur_material = context_entry(l, table, "material", Material::default, usage)?;
+        if self.cur_material.is_none() {
+            self.unnamed_material = Material::default();
         }
         Ok(())
     }

@@ -197,22 +197,22 @@ impl Parser {
                 anyhow!("{loc}: {what}: expected the {kind}-argument count, got '{s}'")
             })
         };
-        let ns = count(w, "string")?;
-        let mut sargs = Vec::with_capacity(ns.min(64)); // counts are checked by what follows
-        for k in 0..ns {
-            sargs.push(word(
-                w,
-                &format!("string argument {} of {ns} of {what}", k + 1),
-            )?);
-        }
-        let ni = count(w, "integer")?;
-        let mut iargs = Vec::with_capacity(ni.min(64));
-        for k in 0..ni {
-            iargs.push(word(
-                w,
-                &format!("integer argument {} of {ni} of {what}", k + 1),
-            )?);
-        }
+        // the string or integer arguments: their count, then as many words
+        let args = |w: &mut Words, kind: &str| -> Result<Vec<String>> {
+            let n = count(w, kind)?;
+            let mut v = Vec::with_capacity(n.min(64)); // counts are checked by what follows
+            for k in 0..n {
+                v.push(word(
+                    w,
+                    &format!("{kind} argument {} of {n} of {what}", k + 1),
+                )?);
+            }
+            Ok(v)
+        };
+        let sargs = args(w, "string")?;
+        let ns = sargs.len();
+        let iargs = args(w, "integer")?;
+        let ni = iargs.len();
         let nr = count(w, "real")?;
         let mut rargs = Vec::with_capacity(nr.min(64));
         let mut rwords = Vec::new();

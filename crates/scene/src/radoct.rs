@@ -55,6 +55,18 @@ impl Reader<'_> {
         Ok(String::from_utf8_lossy(&rest[..end]).into_owned())
     }
 
+    /// Strings up to the empty one that ends the list.
+    fn string_list(&mut self) -> Result<Vec<String>> {
+        let mut out = Vec::new();
+        loop {
+            let s = self.string()?;
+            if s.is_empty() {
+                return Ok(out);
+            }
+            out.push(s);
+        }
+    }
+
     fn real(&mut self) -> Result<f64> {
         let m = self.int(4)?;
         if m == 0 {
@@ -104,14 +116,7 @@ pub fn read(bytes: &[u8]) -> Result<RadianceOctree> {
     for _ in 0..4 {
         r.string()?;
     }
-    let mut files = Vec::new();
-    loop {
-        let f = r.string()?;
-        if f.is_empty() {
-            break;
-        }
-        files.push(f);
-    }
+    let files = r.string_list()?;
     let nobj = r.int(objsize)?;
     if nobj < 0 || nobj as usize > bytes.len() {
         bail!("bad object count {nobj} in octree");
@@ -136,14 +141,7 @@ pub fn read(bytes: &[u8]) -> Result<RadianceOctree> {
     if !files.is_empty() {
         return Ok(RadianceOctree::Files(files));
     }
-    let mut types = Vec::new();
-    loop {
-        let t = r.string()?;
-        if t.is_empty() {
-            break;
-        }
-        types.push(t);
-    }
+    let types = r.string_list()?;
     let mut names: Vec<String> = Vec::with_capacity((nobj as usize).min(1 << 20));
     let mut text = String::new();
     loop {

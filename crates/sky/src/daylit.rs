@@ -171,34 +171,32 @@ fn check_param(m: &mut Model) -> Result<(), DaylitError> {
 }
 
 fn check_irr(dir: &mut f64, dif: &mut f64) -> Result<(), DaylitError> {
-    if *dir > SOLAR_CONSTANT_E {
-        return Err(DaylitError::ErrorSky(
-            "direct irradiance exceeds solar constant".into(),
-        ));
-    }
-    if *dir < 0.0 {
-        eprintln!("Warning: direct irradiance < 0. Using 0.0");
-        *dir = 0.0;
-    }
-    if *dif < 0.0 {
-        eprintln!("Warning: diffuse irradiance < 0. Using 0.0");
-        *dif = 0.0;
-    }
-    Ok(())
+    check_direct_diffuse(dir, dif, SOLAR_CONSTANT_E, "irradiance")
 }
 
 fn check_ill(dir: &mut f64, dif: &mut f64) -> Result<(), DaylitError> {
-    if *dir > SOLAR_CONSTANT_L * 1000.0 {
-        return Err(DaylitError::ErrorSky(
-            "direct illuminance exceeds solar constant".into(),
-        ));
+    check_direct_diffuse(dir, dif, SOLAR_CONSTANT_L * 1000.0, "illuminance")
+}
+
+/// Refuses a direct `what` (irradiance or illuminance) above the solar constant `limit`;
+/// negative direct and diffuse values become 0 with a warning.
+fn check_direct_diffuse(
+    dir: &mut f64,
+    dif: &mut f64,
+    limit: f64,
+    what: &str,
+) -> Result<(), DaylitError> {
+    if *dir > limit {
+        return Err(DaylitError::ErrorSky(format!(
+            "direct {what} exceeds solar constant"
+        )));
     }
     if *dir < 0.0 {
-        eprintln!("Warning: direct illuminance < 0. Using 0.0");
+        eprintln!("Warning: direct {what} < 0. Using 0.0");
         *dir = 0.0;
     }
     if *dif < 0.0 {
-        eprintln!("Warning: diffuse illuminance < 0. Using 0.0");
+        eprintln!("Warning: diffuse {what} < 0. Using 0.0");
         *dif = 0.0;
     }
     Ok(())

@@ -150,6 +150,22 @@ fn keyed<'a>(lines: &'a [String], i: usize, key: &str) -> Option<&'a str> {
     Some(rest.trim())
 }
 
+/// The error maker for data line `line` of a `kind` file; when the line lacks fields (not
+/// `complete`), the error that `expected` were expected and `found` found.
+fn data_line(
+    kind: &'static str,
+    line: usize,
+    complete: bool,
+    expected: &str,
+    found: &dyn std::fmt::Display,
+) -> Result<impl Fn(String) -> WeatherError, WeatherError> {
+    let derr = move |what| WeatherError::Data { kind, line, what };
+    if !complete {
+        return Err(derr(format!("expected {expected}, found {found}")));
+    }
+    Ok(derr)
+}
+
 fn read_wea(lines: &[String]) -> Result<Tape, WeatherError> {
     let herr = |line: usize, expected: &'static str| WeatherError::Header {
         kind: "WEA",
@@ -195,17 +211,13 @@ fn read_wea(lines: &[String]) -> Result<Tape, WeatherError> {
         if w.is_empty() {
             continue;
         }
-        let derr = |what: String| WeatherError::Data {
-            kind: "WEA",
+        let derr = data_line(
+            "WEA",
             line,
-            what,
-        };
-        if w.len() < 5 {
-            return Err(derr(format!(
-                "expected 'month day hour value1 value2', found '{}'",
-                l.trim()
-            )));
-        }
+            w.len() >= 5,
+            "'month day hour value1 value2'",
+            &format_args!("'{}'", l.trim()),
+        )?;
         let month: i32 = w[0]
             .parse()
             .map_err(|_| derr(format!("bad month '{}'", w[0])))?;
@@ -347,17 +359,13 @@ fn read_epw(lines: &[String]) -> Result<Tape, WeatherError> {
             continue;
         }
         let w: Vec<&str> = l.split(',').collect();
-        let derr = |what: String| WeatherError::Data {
-            kind: "EPW",
+        let derr = data_line(
+            "EPW",
             line,
-            what,
-        };
-        if w.len() < 22 {
-            return Err(derr(format!(
-                "expected at least 22 comma-separated fields, found {}",
-                w.len()
-            )));
-        }
+            w.len() >= 22,
+            "at least 22 comma-separated fields",
+            &w.len(),
+        )?;
         let int = |k: usize| -> Result<i32, WeatherError> {
             w[k].trim()
                 .parse::<i32>()

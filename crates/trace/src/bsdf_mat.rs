@@ -12,7 +12,7 @@
 use std::sync::Arc;
 
 use anyhow::{bail, Context, Result};
-use fenestra_bsdf::tree_render::{Lobe, TreeBsdf};
+use fenestra_bsdf::tree_render::{Lobe, Slice, TreeBsdf};
 use fenestra_bsdf::{Direction, KlemsMatrix, Wavelength};
 use fenestra_io::raypath::Resolver;
 use fenestra_scene::Primitive;
@@ -95,32 +95,37 @@ impl LobeData<'_> {
     /// Projected solid angle of the cell holding view `v` (a Klems patch; a tree's smallest
     /// leaf in the view's slice).
     pub fn view_size(&self, v: DVec3) -> f64 {
-        match self {
-            LobeData::Klems(c) => c.view_patch_size(v).unwrap_or(0.0),
-            LobeData::Tree(t, lobe, front) => t
-                .slice(*lobe, *front, v.to_array())
-                .map_or(0.0, |s| s.smallest()),
-        }
+        let klems = |c: &Component| c.view_patch_size(v).unwrap_or(0.0);
+        self.per_view(v, klems, |s| s.smallest(), 0.0)
     }
 
     /// Directional-hemispherical total for view `v`.
     pub fn hemi(&self, v: DVec3) -> f64 {
-        match self {
-            LobeData::Klems(c) => c.hemi(v),
-            LobeData::Tree(t, lobe, front) => t
-                .slice(*lobe, *front, v.to_array())
-                .map_or(0.0, |s| s.total()),
-        }
+        self.per_view(v, |c| c.hemi(v), |s| s.total(), 0.0)
     }
 
     /// Directional-hemispherical total for view `v` in RGB (a grey lobe: the total in
     /// every channel).
     pub fn hemi_rgb(&self, v: DVec3) -> DVec3 {
+        let tree = |s: Slice| DVec3::from(s.total_rgb());
+        self.per_view(v, |c| c.hemi_rgb(v), tree, DVec3::ZERO)
+    }
+
+    /// `klems` of a Klems lobe's component; for a tree lobe, `tree` of its slice for view
+    /// `v`, or `none` where the tree has none.
+    #[inline]
+    fn per_view<R>(
+        &self,
+        v: DVec3,
+        klems: impl FnOnce(&Component) -> R,
+        tree: impl FnOnce(Slice) -> R,
+        none: R,
+    ) -> R {
         match self {
-            LobeData::Klems(c) => c.hemi_rgb(v),
-            LobeData::Tree(t, lobe, front) => t
-                .slice(*lobe, *front, v.to_array())
-                .map_or(DVec3::ZERO, |s| DVec3::from(s.total_rgb())),
+            LobeData::Klems(c) => klems(c),
+            LobeData::Tree(t, lobe, front) => {
+                t.slice(*lobe, *front, v.to_array()).map_or(none, tree)
+            }
         }
     }
 

@@ -123,22 +123,80 @@ fn with_state<R>(id: u64, exe: &Compiled, f: impl FnOnce(&mut fenestra_calc::Sta
     })
 }
 
-/// A pattern compiled from a .cal file.
-pub struct CalPattern {
+/// What a pattern evaluated by the .cal engine evaluates with: its program, the id of its
+/// per-thread states, its frame, the host variables and `arg(n)`.
+struct CalCore {
     exe: Compiled,
     id: u64,
     frame: Option<PatternFrame>,
     vars: Vec<VarId>,
-    exprs: Vec<ExprId>,
     fargs: Vec<f64>,
+}
+
+impl CalCore {
+    /// The core of program `exe` (host variables `vars`), with a new state id.
+    fn new(exe: Compiled, frame: Option<PatternFrame>, vars: Vec<VarId>, fargs: &[f64]) -> CalCore {
+        CalCore {
+            exe,
+            id: NEXT_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
+            frame,
+            vars,
+            fargs: fargs.to_vec(),
+        }
+    }
+
+    /// Runs `f` with this thread's evaluation state, its variables set for ray `q`.
+    #[inline]
+    fn with_ray<R>(
+        &self,
+        q: &PatternInput,
+        f: impl FnOnce(&mut fenestra_calc::State) -> Result<R>,
+    ) -> Result<R> {
+        with_state(self.id, &self.exe, |st| {
+            st.set_all(&self.vars, &CalPattern::values(q, self.frame.as_ref()));
+            st.set_fargs(&self.fargs);
+            f(st)
+        })
+    }
+
+    /// Evaluates `exprs` in state `st` into the start of `out`.
+    #[inline]
+    fn eval_exprs(
+        &self,
+        st: &mut fenestra_calc::State,
+        exprs: &[ExprId],
+        out: &mut [f64],
+    ) -> Result<()> {
+        for (k, e) in exprs.iter().enumerate() {
+            out[k] = self.exe.eval_expr(st, *e).map_err(|e| anyhow!("{e}"))?;
+        }
+        Ok(())
+    }
+
+    /// The debug form of pattern `name` over this core, with its number of `what`.
+    fn debug(
+        &self,
+        f: &mut std::fmt::Formatter<'_>,
+        name: &str,
+        what: &str,
+        count: usize,
+    ) -> std::fmt::Result {
+        f.debug_struct(name)
+            .field(what, &count)
+            .field("fargs", &self.fargs)
+            .finish()
+    }
+}
+
+/// A pattern compiled from a .cal file.
+pub struct CalPattern {
+    core: CalCore,
+    exprs: Vec<ExprId>,
 }
 
 impl std::fmt::Debug for CalPattern {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("CalPattern")
-            .field("exprs", &self.exprs.len())
-            .field("fargs", &self.fargs)
-            .finish()
+        self.core.debug(f, "CalPattern", "exprs", self.exprs.len())
     }
 }
 
@@ -163,12 +221,8 @@ impl CalPattern {
         }
         let exe = p.compile().map_err(|e| anyhow!("{e}"))?;
         let cp = CalPattern {
-            exe,
-            id: NEXT_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
-            frame,
-            vars,
+            core: CalCore::new(exe, frame, vars, fargs),
             exprs: ids,
-            fargs: fargs.to_vec(),
         };
         cp.eval(&TRIAL)?;
         Ok(cp)
@@ -227,13 +281,9 @@ impl CalPattern {
     }
 
     fn eval(&self, q: &PatternInput) -> Result<DVec3> {
-        with_state(self.id, &self.exe, |st| {
-            st.set_all(&self.vars, &Self::values(q, self.frame.as_ref()));
-            st.set_fargs(&self.fargs);
+        self.core.with_ray(q, |st| {
             let mut out = [0.0; 3];
-            for (k, e) in self.exprs.iter().enumerate() {
-                out[k] = self.exe.eval_expr(st, *e).map_err(|e| anyhow!("{e}"))?;
-            }
+            self.core.eval_exprs(st, &self.exprs, &mut out)?;
             if self.exprs.len() == 1 {
                 out = [out[0]; 3];
             }
@@ -261,34 +311,23 @@ pub enum Pattern {
 /// expressions locate the ray in the grids, then the function(s) map the interpolated
 /// values (brightdata: `func(v)`; colordata: `rfunc(r,g,b)`, `gfunc(…)`, `bfunc(…)`).
 pub struct DataPattern {
-    exe: Compiled,
-    id: u64,
-    frame: Option<PatternFrame>,
-    vars: Vec<VarId>,
+    core: CalCore,
     coords: Vec<ExprId>,
     funcs: Vec<FuncId>,
     grids: Vec<DataGrid>,
-    fargs: Vec<f64>,
 }
 
 impl std::fmt::Debug for DataPattern {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("DataPattern")
-            .field("grids", &self.grids.len())
-            .field("fargs", &self.fargs)
-            .finish()
+        self.core.debug(f, "DataPattern", "grids", self.grids.len())
     }
 }
 
 impl DataPattern {
     fn eval(&self, q: &PatternInput) -> Result<DVec3> {
-        with_state(self.id, &self.exe, |st| {
-            st.set_all(&self.vars, &CalPattern::values(q, self.frame.as_ref()));
-            st.set_fargs(&self.fargs);
+        self.core.with_ray(q, |st| {
             let mut x = [0.0f64; 16];
-            for (k, e) in self.coords.iter().enumerate() {
-                x[k] = self.exe.eval_expr(st, *e).map_err(|e| anyhow!("{e}"))?;
-            }
+            self.core.eval_exprs(st, &self.coords, &mut x)?;
             let x = &x[..self.coords.len()];
             let mut v = [0.0f64; 3];
             for (k, g) in self.grids.iter().enumerate() {
@@ -297,7 +336,7 @@ impl DataPattern {
             let v = &v[..self.grids.len()];
             let mut out = [0.0; 3];
             for (k, f) in self.funcs.iter().enumerate() {
-                out[k] = self.exe.call(st, *f, v).map_err(|e| anyhow!("{e}"))?;
+                out[k] = self.core.exe.call(st, *f, v).map_err(|e| anyhow!("{e}"))?;
             }
             if self.funcs.len() == 1 {
                 out = [out[0]; 3];
@@ -454,14 +493,10 @@ fn compile_data(
         })?);
     }
     let dp = DataPattern {
-        exe,
-        id: NEXT_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
-        frame,
-        vars,
+        core: CalCore::new(exe, frame, vars, &q.rargs),
         coords: ids,
         funcs,
         grids,
-        fargs: q.rargs.clone(),
     };
     dp.eval(&TRIAL).map_err(|e| anyhow!("{what}: {e}"))?;
     Ok(Pattern::Data(Arc::new(dp)))

@@ -247,36 +247,33 @@ mod tests {
         assert!((s.normal(DVec3::new(0.0, 0.0, 4.0)) + DVec3::Z).length() < 1e-12);
     }
 
+    /// An outward cone (or cylinder) on the z axis from the origin.
+    fn z_cone(len: f64, r0: f64, r1: f64) -> Shape {
+        Shape::Cone {
+            p0: DVec3::ZERO,
+            axis: DVec3::Z,
+            len,
+            r0,
+            r1,
+            inward: false,
+        }
+    }
+
+    /// Intersection of a ray along +x from (-5, 0, z).
+    fn hit_along_x(s: &Shape, z: f64) -> Option<f64> {
+        s.intersect(DVec3::new(-5.0, 0.0, z), DVec3::X, 0.0, f64::INFINITY)
+    }
+
     #[test]
     fn cylinder_and_cone() {
-        let cyl = Shape::Cone {
-            p0: DVec3::ZERO,
-            axis: DVec3::Z,
-            len: 2.0,
-            r0: 1.0,
-            r1: 1.0,
-            inward: false,
-        };
-        let t = cyl
-            .intersect(DVec3::new(-5.0, 0.0, 1.0), DVec3::X, 0.0, f64::INFINITY)
-            .unwrap();
+        let cyl = z_cone(2.0, 1.0, 1.0);
+        let t = hit_along_x(&cyl, 1.0).unwrap();
         assert!((t - 4.0).abs() < 1e-12);
-        assert!(cyl
-            .intersect(DVec3::new(-5.0, 0.0, 3.0), DVec3::X, 0.0, f64::INFINITY)
-            .is_none());
+        assert!(hit_along_x(&cyl, 3.0).is_none());
         let n = cyl.normal(DVec3::new(-1.0, 0.0, 1.0));
         assert!((n + DVec3::X).length() < 1e-12);
-        let cone = Shape::Cone {
-            p0: DVec3::ZERO,
-            axis: DVec3::Z,
-            len: 1.0,
-            r0: 1.0,
-            r1: 0.0,
-            inward: false,
-        };
-        let t = cone
-            .intersect(DVec3::new(-5.0, 0.0, 0.5), DVec3::X, 0.0, f64::INFINITY)
-            .unwrap();
+        let cone = z_cone(1.0, 1.0, 0.0);
+        let t = hit_along_x(&cone, 0.5).unwrap();
         assert!((t - 4.5).abs() < 1e-12);
         let n = cone.normal(DVec3::new(-0.5, 0.0, 0.5));
         let want = DVec3::new(-1.0, 0.0, 1.0).normalize();

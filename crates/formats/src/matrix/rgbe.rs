@@ -113,7 +113,7 @@ pub fn read_scanline<R: BufRead + ?Sized>(
     let mut shift = 0u32;
     let mut px = first;
     loop {
-        if px[0] == 1 && px[1] == 1 && px[2] == 1 {
+        let repeat = if px[0] == 1 && px[1] == 1 && px[2] == 1 {
             if j == 0 {
                 bail!("{name}: bad RGBE scanline (repeat marker before any pixel)");
             }
@@ -121,17 +121,11 @@ pub fn read_scanline<R: BufRead + ?Sized>(
             if count > len - j {
                 bail!("{name}: bad RGBE scanline (repeat overruns the {len}-pixel row)");
             }
-            let prev = out[j - 1];
-            for p in &mut out[j..j + count] {
-                *p = prev;
-            }
-            j += count;
-            shift += 8;
+            Some(count)
         } else {
-            out[j] = px;
-            j += 1;
-            shift = 0;
-        }
+            None
+        };
+        (j, shift) = crate::picture_rle::flat_step(out, j, shift, px, repeat);
         if j >= len {
             return Ok(());
         }

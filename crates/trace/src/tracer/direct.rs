@@ -174,52 +174,52 @@ impl Tracer {
                         },
                     );
                 };
-                if let Some(cyl) = &s.cyl {
-                    let parts = cyl.partitions(p, self.opts.ds, weight);
-                    let count = parts.len();
-                    let samples: Vec<(DVec3, f64)> = parts
-                        .into_iter()
-                        .filter_map(|(cent, size)| {
-                            let jit = if self.opts.dj > 0.0 {
-                                let u = [cx.rng.next_f64(), cx.rng.next_f64(), cx.rng.next_f64()];
-                                Some((self.opts.dj, u))
-                            } else {
-                                None
-                            };
-                            cyl.sample(p, cent, size, jit)
-                        })
-                        .collect();
-                    for (q, omega) in samples {
-                        emit(cx, q, omega, count, cyl.beyond());
-                    }
-                    return;
-                }
-                if let Some(flat) = &s.flat {
-                    let parts = flat.partitions(p, self.opts.ds, weight);
-                    let count = parts.len();
-                    let samples: Vec<(DVec3, f64)> = parts
-                        .into_iter()
-                        .filter_map(|part| {
-                            let jit = if self.opts.dj > 0.0 {
-                                let u = [cx.rng.next_f64(), cx.rng.next_f64()];
-                                Some((self.opts.dj, u))
-                            } else {
-                                None
-                            };
-                            flat.sample(p, part, count, jit)
-                        })
-                        .collect();
-                    for (q, omega) in samples {
-                        emit(cx, q, omega, count, 0.0);
-                    }
-                    return;
-                }
-                if let Shape::Sphere { c, r, .. } = &self.accel.shapes[sh] {
-                    if let Some(omega) = Self::sphere_omega(*c, *r, p) {
-                        emit(cx, *c, omega, 1, 0.0);
-                    }
+                // a cylinder's or flat source's samples, all drawn before the first is used
+                let (samples, count, beyond): (Vec<(DVec3, f64)>, usize, f64) =
+                    if let Some(cyl) = &s.cyl {
+                        let parts = cyl.partitions(p, self.opts.ds, weight);
+                        let count = parts.len();
+                        let samples = parts
+                            .into_iter()
+                            .filter_map(|(cent, size)| {
+                                cyl.sample(p, cent, size, self.sample_jitter(cx))
+                            })
+                            .collect();
+                        (samples, count, cyl.beyond())
+                    } else if let Some(flat) = &s.flat {
+                        let parts = flat.partitions(p, self.opts.ds, weight);
+                        let count = parts.len();
+                        let samples = parts
+                            .into_iter()
+                            .filter_map(|part| flat.sample(p, part, count, self.sample_jitter(cx)))
+                            .collect();
+                        (samples, count, 0.0)
+                    } else {
+                        if let Shape::Sphere { c, r, .. } = &self.accel.shapes[sh] {
+                            if let Some(omega) = Self::sphere_omega(*c, *r, p) {
+                                emit(cx, *c, omega, 1, 0.0);
+                            }
+                        }
+                        return;
+                    };
+                for (q, omega) in samples {
+                    emit(cx, q, omega, count, beyond);
                 }
             }
+        }
+    }
+
+    /// With `-dj`, it and `N` uniform numbers to jitter a source sample by; else None.
+    #[inline]
+    fn sample_jitter<const N: usize>(&self, cx: &mut Ctx) -> Option<(f64, [f64; N])> {
+        if self.opts.dj > 0.0 {
+            let mut u = [0.0; N];
+            for x in &mut u {
+                *x = cx.rng.next_f64();
+            }
+            Some((self.opts.dj, u))
+        } else {
+            None
         }
     }
 

@@ -44,6 +44,18 @@ pub(super) struct Part {
     pub nv: i64,
 }
 
+impl Part {
+    /// The part's centre and size across u (`along_u`) or across v.
+    #[inline]
+    fn axis_mut(&mut self, along_u: bool) -> (&mut i64, &mut i64) {
+        if along_u {
+            (&mut self.cu, &mut self.nu)
+        } else {
+            (&mut self.cv, &mut self.nv)
+        }
+    }
+}
+
 /// A flat light source's sampling geometry.
 #[derive(Debug, Clone)]
 pub(super) struct FlatSource {
@@ -196,38 +208,18 @@ impl FlatSource {
             out.push(part);
             return;
         }
-        let (lo, hi, du2, dv2) = if du2 > dv2 {
-            let nu = part.nu / 2;
-            (
-                Part {
-                    cu: part.cu - nu,
-                    nu,
-                    ..part
-                },
-                Part {
-                    cu: part.cu + nu,
-                    nu,
-                    ..part
-                },
-                du2 * 0.25,
-                dv2,
-            )
+        // halve the part along its longer side
+        let along_u = du2 > dv2;
+        let (mut lo, mut hi) = (part, part);
+        for (half, side) in [(&mut lo, -1), (&mut hi, 1)] {
+            let (centre, size) = half.axis_mut(along_u);
+            *size /= 2;
+            *centre += side * *size;
+        }
+        let (du2, dv2) = if along_u {
+            (du2 * 0.25, dv2)
         } else {
-            let nv = part.nv / 2;
-            (
-                Part {
-                    cv: part.cv - nv,
-                    nv,
-                    ..part
-                },
-                Part {
-                    cv: part.cv + nv,
-                    nv,
-                    ..part
-                },
-                du2,
-                dv2 * 0.25,
-            )
+            (du2, dv2 * 0.25)
         };
         self.split(p, lo, most / 2, du2, dv2, out);
         self.split(p, hi, most / 2, du2, dv2, out);
