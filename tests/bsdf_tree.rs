@@ -10,17 +10,8 @@ use std::path::{Path, PathBuf};
 /// A scratch copy of the reference office with the window's BSDF file replaced by `tree`
 /// and the sky `sky` (a file of the fixture folder or written here).
 fn office(name: &str, tree: &str) -> PathBuf {
-    let dir = scratch(name);
+    let dir = common::office_scratch(name, &[]);
     let src = fixture("rtrace_threephase_bsdf");
-    for f in [
-        "materials.rad",
-        "room.rad",
-        "exterior.rad",
-        "skyfunc_glow.rad",
-        "sensors.pts",
-    ] {
-        std::fs::copy(src.join(f), dir.join(f)).unwrap();
-    }
     std::fs::copy(
         src.join("sky_t4_sep21_1200_overcast.rad"),
         dir.join("overcast.rad"),

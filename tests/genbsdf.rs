@@ -525,6 +525,14 @@ impl PortBlock {
     fn within3(&self) -> f64 {
         self.z.iter().filter(|v| **v < 3.0).count() as f64 / self.z.len() as f64
     }
+
+    /// Asserts the element-wise agreement: a median |z| in `median` and at least 97.5% of
+    /// the elements within |z| < 3.
+    fn assert_z(&self, median: std::ops::RangeInclusive<f64>) {
+        let (d, m, w) = (self.dir, self.median(), self.within3());
+        assert!(median.contains(&m), "{d:?}: median |z| {m}");
+        assert!(w >= 0.975, "{d:?}: {w} within |z| < 3");
+    }
 }
 
 /// Characterises the device `rad` (written as `file` in a scratch folder `name`) with the
@@ -647,12 +655,7 @@ fn oracle_genbsdf_port_agrees_on_a_glazed_blind() {
     for b in blocks {
         let ((a, o), d) = (b.totals, b.dir);
         assert!((a - o).abs() <= 0.015 * a, "{d:?}: {a} vs {o}");
-        let median = b.median();
-        assert!(
-            (0.55..=0.85).contains(&median),
-            "{d:?}: median |z| {median}"
-        );
-        assert!(b.within3() >= 0.975, "{d:?}: {}", b.within3());
+        b.assert_z(0.55..=0.85);
     }
 }
 
@@ -661,8 +664,8 @@ fn oracle_genbsdf_port_agrees_on_a_glazed_blind() {
 /// diffuse-incidence totals carry no sampling noise: transmission 0.8 × 0.6 = 0.48 and
 /// reflection 0.8 × 0.4 = 0.32 for both tools within 0.1% (measured 0.00–0.01%). Element by
 /// element the distribution is smooth, where joint stratification gains little, so z is about
-/// N(0, 1): median |z| 0.55–0.85 (measured 0.669–0.681 in two runs) and at least 97.5% within 3 (measured
-/// 99.5–99.7%), the glazed blind's limits.
+/// N(0, 1): median |z| 0.55–0.85 (measured 0.669–0.681 in two runs) and at least 97.5%
+/// within 3 (measured 99.5–99.7%), the glazed blind's limits.
 #[test]
 fn oracle_genbsdf_port_agrees_on_a_diffusing_trans_pane() {
     let rad = "void trans diffuser\n0\n0\n7 0.8 0.8 0.8 0 0 0.6 0\n\
@@ -682,12 +685,7 @@ fn oracle_genbsdf_port_agrees_on_a_diffusing_trans_pane() {
                 "{d:?} {who}: {t} vs {exact}"
             );
         }
-        let median = b.median();
-        assert!(
-            (0.55..=0.85).contains(&median),
-            "{d:?}: median |z| {median}"
-        );
-        assert!(b.within3() >= 0.975, "{d:?}: {}", b.within3());
+        b.assert_z(0.55..=0.85);
     }
 }
 
@@ -745,9 +743,7 @@ fn oracle_genbsdf_port_agrees_on_a_perforated_screen() {
             assert!((o - 0.25).abs() <= 0.03 * 0.25, "{d:?}: {o} vs 0.25");
             assert_eq!(b.z.len(), 145, "{d:?}: one element per incident patch");
         }
-        let median = b.median();
-        assert!((0.3..=0.85).contains(&median), "{d:?}: median |z| {median}");
-        assert!(b.within3() >= 0.975, "{d:?}: {}", b.within3());
+        b.assert_z(0.3..=0.85);
     }
 }
 
@@ -1257,19 +1253,10 @@ fn t4_7_runs_in_bounded_memory() {
 #[test]
 fn oracle_rtrace_renders_our_files_as_its_own() {
     let Some(o) = common::oracle() else { return };
-    let dir = scratch("genbsdf-oracle-renders");
-    let src = fixture("rtrace_threephase_bsdf");
-    for f in [
-        "materials.rad",
-        "room.rad",
-        "exterior.rad",
-        "skyfunc_glow.rad",
-        "sensors.pts",
-        "sky_t4_sep21_1200_overcast.rad",
-        "window_bsdf.rad",
-    ] {
-        std::fs::copy(src.join(f), dir.join(f)).unwrap();
-    }
+    let dir = common::office_scratch(
+        "genbsdf-oracle-renders",
+        &["sky_t4_sep21_1200_overcast.rad", "window_bsdf.rad"],
+    );
     std::fs::copy(
         fixture("dctimestep/blinds_t4.xml"),
         dir.join("theirs_t4.xml"),

@@ -104,6 +104,24 @@ pub fn scratch(name: &str) -> PathBuf {
     d
 }
 
+/// A scratch copy (`name`) of the reference office (tests/fixtures/rtrace_threephase_bsdf):
+/// materials, room, exterior, sky function and sensors, and the fixture folder's `extra` files.
+pub fn office_scratch(name: &str, extra: &[&str]) -> PathBuf {
+    let dir = scratch(name);
+    let src = fixture("rtrace_threephase_bsdf");
+    let base = [
+        "materials.rad",
+        "room.rad",
+        "exterior.rad",
+        "skyfunc_glow.rad",
+        "sensors.pts",
+    ];
+    for f in base.iter().chain(extra) {
+        std::fs::copy(src.join(f), dir.join(f)).unwrap();
+    }
+    dir
+}
+
 /// Runs a command, asserting success, and returns its stdout.
 pub fn run_ok(cmd: &mut Command) -> Vec<u8> {
     output_ok(cmd).stdout
