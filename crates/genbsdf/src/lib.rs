@@ -206,6 +206,13 @@ pub(crate) fn sides(opts: &Options) -> Vec<(bool, Direction, Direction)> {
     sides
 }
 
+/// The scramble seeds of one incident direction (`key`) under `seed`, one per coordinate of
+/// [`sample_start`]'s Sobol points.
+pub(crate) fn scramble_seeds(seed: u64, key: u64) -> [u64; 4] {
+    let mut keyed = fenestra_trace::rng::Rng::for_ray(seed ^ 0x736f_626f_6c34, key);
+    [0; 4].map(|_: u64| keyed.next_u64())
+}
+
 /// Where sample `k` of one incident direction starts and which way it heads within the
 /// direction's cell: (x, y) on the box's `w` × `h` face from (x0, y0), and two numbers in
 /// [0,1) for the direction (in that order: y, direction, direction, x), from a scrambled
@@ -214,18 +221,15 @@ pub(crate) fn sides(opts: &Options) -> Vec<(bool, Direction, Direction)> {
 /// The four are stratified jointly, not each pair on its own: whether a ray passes between
 /// two slats depends on where it starts across them and on its direction together, and a
 /// joint stratification estimates that fraction far better than independently stratified
-/// start points and directions paired at random. The scramble (`seed`, `key` = the
-/// incident direction) keeps every sample uniform, so the mean stays unbiased; `rng` (the
-/// sample's own stream) fills the digits below the 32nd.
+/// start points and directions paired at random. The scramble (`seeds`, from
+/// [`scramble_seeds`] of the incident direction) keeps every sample uniform, so the mean
+/// stays unbiased; `rng` (the sample's own stream) fills the digits below the 32nd.
 pub(crate) fn sample_start(
-    seed: u64,
-    key: u64,
+    seeds: [u64; 4],
     k: usize,
     rng: &mut fenestra_trace::rng::Rng,
     (x0, y0, w, h): (f64, f64, f64, f64),
 ) -> (f64, f64, f64, f64) {
-    let mut keyed = fenestra_trace::rng::Rng::for_ray(seed ^ 0x736f_626f_6c34, key);
-    let seeds = [0; 4].map(|_: u64| keyed.next_u64());
     let [y, u0, u1, x] = fenestra_trace::sobol::point4(k as u32, seeds, || rng.next_f64());
     (x0 + w * x, y0 + h * y, u0, u1)
 }
@@ -361,11 +365,12 @@ pub fn characterise_with(
                     let mut sz = sx.clone();
                     let mut hits: Vec<(usize, f64)> = Vec::new();
                     let key = (side_k * np + i) as u64;
+                    let seeds = scramble_seeds(seed, key);
                     for k in 0..n {
                         hits.clear();
                         let index = (key * n as u64) + k as u64;
                         let mut rng = fenestra_trace::rng::Rng::for_ray(seed, index);
-                        let (px, py, u0, u1) = sample_start(seed, key, k, &mut rng, (x0, y0, w, h));
+                        let (px, py, u0, u1) = sample_start(seeds, k, &mut rng, (x0, y0, w, h));
                         let Some(b) = basis.sample_projected(i, u0, u1) else {
                             continue;
                         };

@@ -18,7 +18,8 @@ use rayon::prelude::*;
 use crate::reduce::{reciprocity, reduce, Grid};
 use crate::reduce_stream::{Rows, StreamReduce};
 use crate::{
-    add_squares, grid, sample_seed, sample_start, setup, sides, Characterised, Options, Setup,
+    add_squares, grid, sample_seed, sample_start, scramble_seeds, setup, sides, Characterised,
+    Options, Setup,
 };
 
 /// The grid cell of a unit direction of travel (its x and y on the disk).
@@ -188,11 +189,12 @@ pub fn characterise(
             let mut sq = vec![0.0; if opts.errors { 2 * ncell } else { 0 }];
             let mut hits: Vec<(usize, f64)> = Vec::new();
             let key = (side_k * nin + cell) as u64;
+            let seeds = scramble_seeds(seed, key);
             for k in 0..ns {
                 hits.clear();
                 let index = key * ns as u64 + k as u64;
                 let mut rng = Rng::for_ray(seed, index);
-                let (px, py, s1, s2) = sample_start(seed, key, k, &mut rng, (x0, y0, w, h));
+                let (px, py, s1, s2) = sample_start(seeds, k, &mut rng, (x0, y0, w, h));
                 let (dx, dy) = if rank == 4 {
                     square_to_disk((ix as f64 + s1) / n as f64, (iy as f64 + s2) / n as f64)
                 } else {
