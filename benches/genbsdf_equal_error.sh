@@ -7,8 +7,8 @@
 #     ambient sampling: 0.1% of transmission), so reruns are not replicates. Runs with other sample grids are:
 #     -c 960 and -c 1050 (32 x 31 and 34 x 31 samples against 33 x 31), light from the room only; the spread of the
 #     three runs, scaled to the 1023 samples of -c 1000 by the square root of the sample counts, is the noise.
-#   - fenestra: genBSDF -n 2 -c N +C +f +b, timed; its noise: the spread of K replicates (-r '-seed S', light from
-#     the room) at the same -c.
+#   - fenestra: genBSDF -n 2 -c N +C +f +b, timed; its noise: the spread of K replicates (-r '-seed S') at the same
+#     -c, light from the room only and grey (the Visible blocks do not depend on +C or +f).
 #   Noise metric, per block (light from the room: transmission, reflection): relative rms over the 145 x 145
 #   elements of the flux fraction (BSDF x the outgoing patch's projected solid angle), i.e.
 #   sqrt(sum of element variances / sum of squared element means).
@@ -20,11 +20,9 @@ set -a; . .oracle/env; set +a
 export FENESTRA_NO_PROGRESS=1
 N=${1:-450}
 K=${2:-4}
-top=$PWD
+[ "$K" -ge 2 ] || { echo "genbsdf_equal_error.sh: K (replicates) must be at least 2" >&2; exit 2; }
 bin=$(realpath "${CARGO_TARGET_DIR:-target}/testopt")
 py="$PWD/.oracle/venv/bin/python"
-ref_kf=$(realpath "${FENESTRA_SHARED:-../shared}/reference/genbsdf/blinds_kf.xml" 2>/dev/null || true)
-[ -f "$ref_kf" ] || ref_kf="$top/tests/fixtures/threephase/blinds_kf.xml"
 tmp=$(mktemp -d); [ -n "${KEEP:-}" ] || trap 'rm -rf "$tmp"' EXIT; echo "work: $tmp"
 "$FENESTRA_ORACLE_BIN/mgf2rad" tests/fixtures/genbsdf/blinds_curved20.mgf > "$tmp/blind.rad"
 cd "$tmp"

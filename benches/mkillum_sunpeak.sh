@@ -2,7 +2,9 @@
 # mkillum's p+ on a sun peak (issue 19): a 4 x 5 x 3 m room, a 1.5 x 1 m clear-glass window facing south, the sun at
 # 30 deg altitude due south, and a 2 m deep rough-metal light shelf just below the sill that reflects the sun up
 # through the window onto the ceiling (a patch of about 23 klx). One cell of the window's d=48 distribution holds
-# 42% of its light; p+ samples the window again at 4x the density until no cell holds a peak (here d=3072).
+# 42% of its light (mkillum -v reports it); p+ samples the window again at 4x the density until no cell holds a peak
+# (d=3072 here). mkillum runs once per setting (its default seed): at d=48 the window's output varies by about 26%
+# (sd) from seed to seed (docs/tools/mkillum.md), so the d=48 row is one draw of that.
 # Compared at 456 ceiling sensors (looking down) and 63 work-plane sensors (looking up), in lux, against a rendering
 # without the proxy (-ab 4 -ad 16384, mean of REF seeds): the proxy renderings (-ab 3, one bounce fewer since the
 # proxy turns the window's light into direct light; -ds .02 -dj 1) are means of RENDERS seeds. Prints per zone
@@ -14,6 +16,9 @@ cd "$(dirname "$0")/.."
 renders=${1:-8}
 refs=${2:-6}
 bin=$(realpath "${CARGO_TARGET_DIR:-target}/testopt")
+for t in gensky oconv rtrace rcalc mkillum; do
+  [ -x "$bin/$t" ] || { echo "mkillum_sunpeak.sh: no $bin/$t (build with --profile testopt)" >&2; exit 1; }
+done
 export PATH="$bin:$PATH" RAYPATH=".:$(realpath lib)" FENESTRA_NO_PROGRESS=1
 tmp=$(mktemp -d); [ -n "${KEEP:-}" ] || trap 'rm -rf "$tmp"' EXIT; echo "work: $tmp"
 cd "$tmp"

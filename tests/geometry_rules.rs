@@ -9,7 +9,7 @@ mod common;
 
 const SCENE: &str = "void plastic m 0 0 5 .5 .5 .5 0 0
 void glow g 0 0 4 1 1 1 0
-g source s 0 0 4 0 0 1 180
+g source s 0 0 4 0 0 1 90
 m cylinder c1 0 0 7 0 0 0 0 0 1 -1
 m tube t1 0 0 7 10 0 0 10 0 1 -1
 m cone k1 0 0 8 20 0 0 20 0 1 -1 -2
@@ -21,11 +21,43 @@ m sphere sp 0 0 4 70 0 0 1
 ";
 
 /// From outside and inside each shape, onto the ring and the polygon from both sides, into
-/// the sphere, and one ray that hits nothing. Deterministic (`-ab 0`, first hits): the same
-/// printed digits as the oracle's, a zero's sign aside.
+/// the sphere, one ray onto the distant source (the upper hemisphere) and one down that hits
+/// nothing. Deterministic (`-ab 0`, first hits): within 1e-6 relative (and 1e-9 absolute) of
+/// the oracle's printed digits, which covers their last digit's rounding.
 const RAYS: &str = "5 0 .5 -1 0 0\n0 0 .5 1 0 0\n15 0 .5 -1 0 0\n10 0 .5 1 0 0\n\
 25 0 .5 -1 0 0\n20 0 .5 1 0 0\n35 0 .5 -1 0 0\n45 0 .5 -1 0 0\n40 0 .5 1 0 0\n\
-51.5 0 5 0 0 -1\n61 0 1 0 0 -1\n61 0 -1 0 0 1\n68 0 0 1 0 0\n5 5 5 0 0 1\n";
+51.5 0 5 0 0 -1\n61 0 1 0 0 -1\n61 0 -1 0 0 1\n68 0 0 1 0 0\n5 5 5 0 0 1\n5 5 5 0 0 -1\n";
+
+/// Our rtrace alone: NCOMP counts the record's numbers (d 3, L 1, N 3, n 3), every inside-out
+/// shape is warned about, and the ray that hits nothing gives zero normals (its distance is
+/// Radiance's "infinite" 1e10).
+#[test]
+fn odd_radii_warnings_ncomp_and_a_miss() {
+    let dir = common::scratch("geometry_rules_ours");
+    std::fs::write(dir.join("scene.rad"), SCENE).unwrap();
+    let mut c = common::fenestra("rtrace");
+    c.args(["-ab", "0", "-odLNn", "scene.rad"])
+        .current_dir(&dir);
+    let out = common::run_stdin_ok(c, RAYS.as_bytes());
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(text.contains("NCOMP=10\n"), "{text}");
+    let last = common::numbers(text.lines().last().unwrap().as_bytes());
+    assert_eq!(last.len(), 10, "{text}");
+    assert!(
+        last[3] >= 1e10 && last[4..].iter().all(|v| *v == 0.0),
+        "the miss: {last:?}"
+    );
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    for w in [
+        "cylinder 'c1': negative radius",
+        "tube 't1': negative radius",
+        "cone 'k1': negative radii",
+        "cup 'k3': negative radii",
+    ] {
+        assert!(err.contains(w), "{err}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
 
 #[test]
 fn oracle_odd_radii_and_first_hit_normals() {
@@ -36,20 +68,6 @@ fn oracle_odd_radii_and_first_hit_normals() {
     std::fs::write(dir.join("scene.rad"), SCENE).unwrap();
     let (t, o) = common::both_rtrace(&oracle, &dir, &["-h", "-ab", "0", "-odLNn"], RAYS);
     common::agree("-odLNn", &t, &o, 1e-6, 1e-9);
-    // NCOMP counts the record's numbers (d 3, L 1, N 3, n 3)
-    let mut c = common::fenestra("rtrace");
-    c.args(["-ab", "0", "-odLNn", "scene.rad"])
-        .current_dir(&dir);
-    let out = common::run_stdin_ok(c, b"");
-    let head = String::from_utf8_lossy(&out.stdout).into_owned();
-    assert!(head.contains("NCOMP=10\n"), "{head}");
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    for w in [
-        "cylinder 'c1': negative radius",
-        "cone 'k1': negative radii",
-    ] {
-        assert!(err.contains(w), "{err}");
-    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -61,7 +79,17 @@ fn pcomb_nfiles_and_xform_zero_array() {
     let mut c = common::fenestra("pcomb");
     c.args(["-x", "2", "-y", "2", "-e", "lo=nfiles+1"]);
     let pic = common::run_ok(&mut c);
-    assert!(pic.starts_with(b"#?RADIANCE"));
+    let p = fenestra_formats::picture::Picture::read(&mut &pic[..], "pcomb").unwrap();
+    // no input files: nfiles + 1 = 1 in every channel of the 4 pixels (to RGBE's 1/128)
+    assert_eq!(p.pixels.len(), 4);
+    assert!(
+        p.pixels
+            .iter()
+            .flatten()
+            .all(|v| (v - 1.0).abs() <= 1.0 / 128.0),
+        "{:?}",
+        p.pixels
+    );
     std::fs::write(dir.join("x.rad"), "void plastic m 0 0 5 .5 .5 .5 0 0\n").unwrap();
     let mut x = common::fenestra("xform");
     x.args(["-a", "0", "-t", "1", "0", "0", "x.rad"])

@@ -95,7 +95,7 @@ fn pattern_errors_are_clear() {
 /// transform, against the reference rtrace.
 #[test]
 fn oracle_pattern_transforms_match_rtrace() {
-    let Some((oracle, dir)) = common::probe::oracle_dir("patterns_xf") else {
+    let Some((oracle, dir)) = common::cli::oracle_scratch("patterns_xf") else {
         return;
     };
     std::fs::write(dir.join("ramp.dat"), "1\n-3 3 5\n1 2 4 3 2.5\n").unwrap();

@@ -570,7 +570,9 @@ fn oracle_trailing_ops_broadcast_chain_order_division() {
     );
     common::assert_ok(&out);
     let e = std::fs::read_to_string(dir.join("e.err")).unwrap();
-    assert!(e.contains("NCOMP=3\n"), "{e}");
+    for field in ["NCOMP=3\n", "NROWS=5\n", "NCOLS=7\n"] {
+        assert!(e.contains(field), "{field}: {e}");
+    }
     for case in [
         "-fa A.mtx / F1.mtx",
         "-fa A.mtx / C.mtx",

@@ -106,10 +106,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         match o.key {
             "c" => opt.color = o.vec3(),
             "m" => {
-                opt.mf = usize::try_from(o.int())
-                    .ok()
-                    .filter(|&v| v >= 1)
-                    .ok_or_else(|| anyhow!("-m needs a positive integer, got {}", o.int()))?;
+                opt.mf =
+                    o.positive_int(|v| format!("-m needs a positive integer, got {v}"))? as usize;
             }
             "d" => opt.sky = false,
             "h" => header = false,

@@ -12,13 +12,6 @@ pub fn scene_dir(name: &str, scene: &str) -> PathBuf {
     dir
 }
 
-/// The oracle and a fresh scratch folder `name`; `None`, with no folder made, where the
-/// oracle is missing (see [`super::oracle`]).
-pub fn oracle_dir(name: &str) -> Option<(Oracle, PathBuf)> {
-    let oracle = super::oracle()?;
-    Some((oracle, super::scratch(name)))
-}
-
 /// The oracle and [`scene_dir`]`(name, scene)`; `None`, with nothing written, where the
 /// oracle is missing (see [`super::oracle`]).
 pub fn oracle_scene(name: &str, scene: &str) -> Option<(Oracle, PathBuf)> {

@@ -83,6 +83,15 @@ mod libm {
 }
 
 impl Builtin {
+    /// The fewest arguments a call takes.
+    pub fn min_args(self) -> usize {
+        match self {
+            Builtin::If => 3,
+            Builtin::Atan2 | Builtin::Jn | Builtin::Yn => 2,
+            _ => 1,
+        }
+    }
+
     /// The name the language calls it by.
     pub fn name(self) -> &'static str {
         match self {
@@ -270,12 +279,7 @@ pub fn lookup(name: &str, extras: Extras) -> Option<(Builtin, usize)> {
         B::Arg => extras.render,
         _ => true,
     };
-    let min_args = match b {
-        B::If => 3,
-        B::Atan2 | B::Jn | B::Yn => 2,
-        _ => 1,
-    };
-    enabled.then_some((b, min_args))
+    enabled.then_some((b, b.min_args()))
 }
 
 #[cfg(test)]

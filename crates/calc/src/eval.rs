@@ -643,11 +643,7 @@ impl Compiled {
     }
 
     fn builtin_body(&self, b: Builtin, args: &[Node], st: &mut State, fr: &Frame) -> f64 {
-        let need = match b {
-            Builtin::If => 3,
-            Builtin::Atan2 | Builtin::Jn | Builtin::Yn => 2,
-            _ => 1,
-        };
+        let need = b.min_args();
         if args.len() < need {
             return self.dyn_fail(
                 st,

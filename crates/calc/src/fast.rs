@@ -716,11 +716,7 @@ impl<'a> Fc<'a> {
     }
 
     fn builtin(&mut self, b: Builtin, args: &'a [Node], fr: usize) -> Result<u32, GiveUp> {
-        let need = match b {
-            Builtin::If => 3,
-            Builtin::Atan2 | Builtin::Jn | Builtin::Yn => 2,
-            _ => 1,
-        };
+        let need = b.min_args();
         if args.len() < need {
             return self.abort();
         }

@@ -41,7 +41,8 @@ impl Checkpoint {
     /// Opens (or starts) the checkpoint `path` for a run whose numbers are fixed by `key`.
     pub(crate) fn open(path: &Path, key: &str) -> Result<Checkpoint> {
         let mut done = HashMap::new();
-        let key_line = format!("fenestra genBSDF checkpoint 1 {key}");
+        // version 2: the Sobol sampler (a version-1 file holds another sampler's sums)
+        let key_line = format!("fenestra genBSDF checkpoint 2 {key}");
         let exists = path.exists();
         if exists {
             let f = std::fs::File::open(path)

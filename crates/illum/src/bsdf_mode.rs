@@ -15,7 +15,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::geometry::Face;
-use crate::sample::{stratified2, Distribution, Job};
+use crate::sample::{Distribution, Job};
+use fenestra_trace::rng::stratified2;
 
 /// Grid of the written distribution: altitude rows (uniform in sin²θ) and azimuth columns.
 pub const GRID: (usize, usize) = (45, 72);

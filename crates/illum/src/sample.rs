@@ -5,7 +5,7 @@
 //! its tracer stream are keyed by the seed, the surface's number and the ray's index, so
 //! the result does not depend on the thread count.
 
-use fenestra_trace::rng::{spread2, Rng};
+use fenestra_trace::rng::{stratified2, Rng};
 use fenestra_trace::Tracer;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -132,13 +132,6 @@ pub fn flatindex(dv: DVec3, nalt: usize, nazi: usize) -> usize {
         j = 0;
     }
     i * nazi + j
-}
-
-/// Two numbers in [0, 1) for sample `i` of `s`: the first stratified (drawn in the
-/// sample's 1/`s` of the range), both then spread by [`spread2`].
-pub(crate) fn stratified2(i: usize, s: usize, rng: &mut Rng) -> (f64, f64) {
-    let t = (i as f64 + rng.next_f64()) / s as f64;
-    spread2(t, rng)
 }
 
 /// What the sampler needs besides the surface.

@@ -135,12 +135,11 @@ impl Site {
 /// Radiance warns that its formula is out of range, it is kept so that positions agree with
 /// Radiance's (1900: a day from the Gregorian date).
 fn days_from_civil(y: i32, m: i32, d: i32) -> i64 {
-    const MONTH_START: [i64; 12] = [0, 31, 59, 90, 120, 151, 181, 212, 243, 273, 304, 334];
     let m = m.clamp(1, 12);
     let leap = i64::from(m > 2 && y & 3 == 0);
     let since = i64::from(y) - 1949;
     // Radiance's Julian-date origin is 2432916.5 (1948-12-31 00:00 UT); J2000 is 2451545.
-    MONTH_START[(m - 1) as usize] + i64::from(d) + leap + since * 365 + since / 4 - 18628
+    i64::from(MONTH_START[(m - 1) as usize]) + i64::from(d) + leap + since * 365 + since / 4 - 18628
 }
 
 /// A computed solar position.

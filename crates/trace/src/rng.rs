@@ -72,6 +72,13 @@ pub fn spread2(t: f64, rng: &mut Rng) -> (f64, f64) {
     )
 }
 
+/// Two numbers in [0, 1) for sample `i` of `s`: the first stratified (drawn in the
+/// sample's 1/`s` of the range), both then spread over the square by [`spread2`].
+pub fn stratified2(i: usize, s: usize, rng: &mut Rng) -> (f64, f64) {
+    let t = (i as f64 + rng.next_f64()) / s as f64;
+    spread2(t, rng)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,9 +1,11 @@
 //! Randomised quasi-Monte Carlo points: the first four dimensions of Sobol's sequence,
-//! each scrambled by a seeded nested (Owen) permutation of its binary digits.
+//! each scrambled by a seeded, hash-based nested permutation of its binary digits (Owen's
+//! scrambling with the permutations drawn from a hash, as Laine and Karras's).
 //!
-//! Every one- and two-dimensional projection of the first 2^m points is stratified (one
-//! point in each of 2^m equal cells, and the 2-d pairs in elementary rectangles), jointly
-//! and not only dimension by dimension; the scramble keeps that and makes each point
+//! Every one-dimensional projection of the first 2^m points is stratified (one point in
+//! each of 2^m equal cells) and every pair of dimensions jointly: dimensions 0 and 1 form a
+//! (0, m, 2)-net (one point in every elementary rectangle of area 2^-m), the other pairs
+//! (t, m, 2)-nets with t ≤ 2 (tested); the scramble keeps that and makes each point
 //! uniform on [0,1)^4, so a mean over the points is an unbiased estimate whose error
 //! falls faster than independent samples' where the integrand has structure across
 //! dimensions (a ray's start point and direction jointly deciding whether it passes
@@ -74,7 +76,7 @@ pub fn sobol_bits(index: u32, dim: usize) -> u32 {
     x
 }
 
-/// A nested uniform scramble of 32 binary digits under `seed`: each output digit is the
+/// A hash-based nested scramble of 32 binary digits under `seed`: each output digit is the
 /// input digit flipped or not by a function of the seed and the more significant digits
 /// only (so every elementary interval maps onto one of the same size).
 pub fn owen_scramble(x: u32, seed: u64) -> u32 {
@@ -88,7 +90,7 @@ pub fn owen_scramble(x: u32, seed: u64) -> u32 {
     y ^= y.wrapping_mul(0x9e37_79b8);
     y = y.wrapping_add(s1.rotate_left(13));
     y ^= y.wrapping_mul(0x2c1b_3c6c);
-    y = y.wrapping_mul(0xa54f_f53b | 1);
+    y = y.wrapping_mul(0xa54f_f53b);
     y.reverse_bits()
 }
 

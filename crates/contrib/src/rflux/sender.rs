@@ -5,7 +5,7 @@
 
 use anyhow::{bail, Result};
 use fenestra_bsdf::tree::square_to_disk;
-use fenestra_trace::rng::{spread2, Rng};
+use fenestra_trace::rng::{spread2, stratified2, Rng};
 use glam::DVec3;
 
 use super::directive::Basis;
@@ -125,8 +125,7 @@ impl Sampler {
         let index = (b as u64) * (c as u64) + k as u64;
         let mut rng = Rng::for_ray(self.seed ^ 0x5f1e_c7ed_0000_0001, index);
         // direction: stratum k of the bin, spread over the square
-        let t = (k as f64 + rng.next_f64()) / c as f64;
-        let (s1, s2) = spread2(t, &mut rng);
+        let (s1, s2) = stratified2(k, c, &mut rng);
         // origin: an independent stratum (a permutation of k)
         let kk = ((k as u128 * coprime_step(c) as u128 + (b as u128) * 7_777) % c as u128) as f64;
         let x = (kk + rng.next_f64()) / c as f64;

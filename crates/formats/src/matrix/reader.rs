@@ -135,7 +135,7 @@ impl MatrixReader {
         name: &str,
         info: MatrixInfo,
     ) -> Result<MatrixReader> {
-        Self::with_info(Box::new(reader), name, info, Vec::new())
+        Self::with_info(Box::new(reader), name, info)
     }
 
     fn from_boxed(mut r: Box<dyn BufRead + Send>, name: &str) -> Result<MatrixReader> {
@@ -172,12 +172,6 @@ impl MatrixReader {
             let c = ncols.with_context(|| format!("{name}: missing NCOLS= in matrix header"))?;
             (nrows, c)
         };
-        let mut divide = Vec::new();
-        if exposure != 1.0 || cc != [1.0; 3] {
-            divide = (0..ncomp)
-                .map(|k| exposure * cc[if k < 3 { k } else { 1 }])
-                .collect();
-        }
         let info = MatrixInfo {
             nrows,
             ncols,
@@ -186,15 +180,17 @@ impl MatrixReader {
             big_endian,
             header,
         };
-        Self::with_info(r, name, info, divide)
+        let mut m = Self::with_info(r, name, info)?;
+        // one divisor per component, made only once the header's sizes are checked
+        if exposure != 1.0 || cc != [1.0; 3] {
+            m.divide = (0..ncomp)
+                .map(|k| exposure * cc[if k < 3 { k } else { 1 }])
+                .collect();
+        }
+        Ok(m)
     }
 
-    fn with_info(
-        r: Box<dyn BufRead + Send>,
-        name: &str,
-        info: MatrixInfo,
-        divide: Vec<f64>,
-    ) -> Result<MatrixReader> {
+    fn with_info(r: Box<dyn BufRead + Send>, name: &str, info: MatrixInfo) -> Result<MatrixReader> {
         if info.ncols == 0 || info.ncomp == 0 {
             bail!("{name}: matrix has no columns or components");
         }
@@ -215,7 +211,7 @@ impl MatrixReader {
             name: name.to_string(),
             r,
             rows_read: 0,
-            divide,
+            divide: Vec::new(),
             swap,
             bytes: Vec::new(),
             pixels: Vec::new(),
@@ -493,4 +489,25 @@ fn read_resolution<R: BufRead + ?Sized>(r: &mut R, name: &str) -> Result<(usize,
         "{name}: bad resolution string '{}' (matrices need the standard '-Y rows +X columns' order, or NCOLS= in the header)",
         s.trim_end()
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::MatrixReader;
+
+    /// A header's component count is checked before anything is sized by it, also when an
+    /// exposure asks for one divisor per component (found by tests/fuzz_parsers.rs: an
+    /// 8 TB allocation).
+    #[test]
+    fn huge_ncomp_with_exposure_is_an_error_not_an_allocation() {
+        let text =
+            "#?RADIANCE\nNROWS=1\nNCOLS=1\nNCOMP=999999999993\nEXPOSURE=2\nFORMAT=ascii\n\n1\n";
+        let err = MatrixReader::from_reader(std::io::Cursor::new(text.as_bytes().to_vec()), "m")
+            .err()
+            .expect("an error");
+        assert!(
+            format!("{err:#}").contains("too large for a matrix row"),
+            "{err:#}"
+        );
+    }
 }
