@@ -209,8 +209,7 @@ pub(crate) fn sides(opts: &Options) -> Vec<(bool, Direction, Direction)> {
 /// The scramble seeds of one incident direction (`key`) under `seed`, one per coordinate of
 /// [`sample_start`]'s Sobol points.
 pub(crate) fn scramble_seeds(seed: u64, key: u64) -> [u64; 4] {
-    let mut keyed = fenestra_trace::rng::Rng::for_ray(seed ^ 0x736f_626f_6c34, key);
-    [0; 4].map(|_: u64| keyed.next_u64())
+    fenestra_trace::sobol::scramble_seeds(seed ^ 0x736f_626f_6c34, key)
 }
 
 /// Where sample `k` of one incident direction starts and which way it heads within the

@@ -106,6 +106,13 @@ pub fn point4(index: u32, seeds: [u64; 4], mut fill: impl FnMut() -> f64) -> [f6
     out
 }
 
+/// Four scramble seeds (one per dimension of [`point4`]) for the point set keyed by `key`
+/// under `seed`: each set (an incident direction, a distribution bin) gets its own scramble.
+pub fn scramble_seeds(seed: u64, key: u64) -> [u64; 4] {
+    let mut keyed = crate::rng::Rng::for_ray(seed, key);
+    [0; 4].map(|_: u64| keyed.next_u64())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
