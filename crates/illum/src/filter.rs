@@ -319,33 +319,52 @@ impl<'a> Filter<'a> {
             .and_then(|f| self.bsdfs.get(f))
             .cloned();
         if let Some(data) = bsdf {
-            let job = self.job(p, self.settings.sampdens, Some(data.incident.len()));
+            let job = self.job(p, self.settings.sampdens, Some(data.incident.len()), 0);
             return self.convert_bsdf(p, name, out, &job, &data);
         }
         let keep = self.settings.sampdens;
         let mut dens = keep;
-        let (dist, axes, peak) = loop {
-            let job = self.job(p, dens, None);
-            let Some((dist, axes)) = self.sample_traced(p, name, out, &job)? else {
-                return Ok(());
-            };
+        let job = self.job(p, dens, None, 0);
+        let Some((mut dist, axes)) = self.sample_traced(p, name, out, &job)? else {
+            return Ok(());
+        };
+        let sphere = p.ptype == "sphere";
+        let mut level = 0;
+        let peak = loop {
             let peak = if dens > 0 { dist.peak() } else { None };
-            // p+: a peak in one cell: the surface again at 4× the density, while that
-            // stays within d=4096
+            // p+: a peak in one cell: the directions around it sampled again at 4× the
+            // density (the others keep their values), while that stays within d=4096
             let refine = self.settings.refine && dens > 0 && dens * 4 <= 4096;
             match peak {
-                Some(share) if refine => {
+                Some((share, at)) if refine => {
+                    level += 1;
+                    let around = sample::neighbourhood(at, (dist.nalt, dist.nazi), sphere);
+                    let mut fine = self.job(p, dens * 4, None, level);
+                    let grid = (fine.nalt, fine.nazi);
+                    let picked: Vec<bool> = (0..grid.0 * grid.1)
+                        .map(|k| around[sample::containing_bin(k, grid, (dist.nalt, dist.nazi))])
+                        .collect();
                     warn(format!(
-                        "{} \"{}\": one of its {} directions carries {:.0}% of the light at d={dens}: sampled again at d={} (p+)",
+                        "{} \"{}\": one of its {} directions carries {:.0}% of the light at d={dens}: sampled again at d={} (p+) in the {} directions around it",
                         p.ptype,
                         p.name,
                         dist.sums.len(),
                         100.0 * share,
-                        dens * 4
+                        dens * 4,
+                        picked.iter().filter(|&&x| x).count()
                     ));
+                    fine.only = Some(picked.clone());
+                    if let Some(pr) = self.progress {
+                        pr.restart(fine.rays() as u64, &format!("mkillum {}", p.name));
+                    }
+                    let Some((mut finer, _)) = self.sample_traced(p, name, out, &fine)? else {
+                        return Ok(());
+                    };
+                    finer.fill_from(&dist, &picked);
+                    dist = finer;
                     dens *= 4;
                 }
-                _ => break (dist, axes, peak),
+                _ => break peak.map(|(share, _)| share),
             }
         };
         // the distribution is written at the density used
@@ -357,7 +376,8 @@ impl<'a> Filter<'a> {
 
     /// The sampling job of surface number `self.surfaces` (`p`) at density `dens`;
     /// `bsdf_patches`: the incident patches of the BSDF-data mode (for the progress bar).
-    fn job(&self, p: &Prim, dens: i64, bsdf_patches: Option<usize>) -> Job<'a> {
+    /// `level`: the refinement level (`p+`), which keys streams of its own.
+    fn job(&self, p: &Prim, dens: i64, bsdf_patches: Option<usize>, level: u64) -> Job<'a> {
         let (nalt, nazi) = match p.ptype.as_str() {
             "sphere" => crate::directives::round_divisions(dens),
             _ => crate::directives::flat_divisions(dens),
@@ -365,12 +385,13 @@ impl<'a> Filter<'a> {
         let nsamps = self.settings.nsamps.max(1) as usize;
         let job = Job {
             tracer: self.tracer,
-            seed: self.seed,
+            seed: self.seed ^ level.wrapping_mul(0x9e37_79b9_7f4a_7c15),
             surface: self.surfaces,
             nalt,
             nazi,
             nsamps,
             light: self.settings.light,
+            only: None,
             progress: self.progress,
         };
         if let Some(pr) = self.progress {
@@ -462,7 +483,7 @@ impl<'a> Filter<'a> {
         // the distribution is always written, whatever d= was before
         let keep = self.settings.sampdens;
         self.settings.sampdens = self.settings.sampdens.max(1);
-        let peak = dist.peak();
+        let peak = dist.peak().map(|(share, _)| share);
         let r = self.finish_surface(p, out, dist, Some(axes), peak);
         self.settings.sampdens = keep;
         r

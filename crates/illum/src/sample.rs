@@ -63,19 +63,38 @@ impl Distribution {
     }
 
     /// A peak: the share of the light (the bins hold equal projected solid angles) in the
-    /// brightest bin, when that bin holds more than a quarter of it and is over 20 times the
-    /// median bin (a sun seen by way of specular surfaces, which a cell spreads out).
-    pub fn peak(&self) -> Option<f64> {
+    /// brightest bin, and that bin, when it holds more than a quarter of the light and is
+    /// over 20 times the median bin (a sun seen by way of specular surfaces, which a cell
+    /// spreads out).
+    pub fn peak(&self) -> Option<(f64, usize)> {
         let mut lum: Vec<f64> = self.sums.iter().map(|v| crate::bright(*v)).collect();
         let total: f64 = lum.iter().sum();
         if lum.len() < 4 || total.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return None;
         }
-        let max = lum.iter().copied().fold(0.0f64, f64::max);
+        // the first brightest bin
+        let (at, max) =
+            lum.iter().copied().enumerate().fold(
+                (0, 0.0f64),
+                |(k, m), (i, v)| if v > m { (i, v) } else { (k, m) },
+            );
         let mid = lum.len() / 2;
         let median = *lum.select_nth_unstable_by(mid, f64::total_cmp).1;
         let share = max / total;
-        (share > 0.25 && max > 20.0 * median).then_some(share)
+        (share > 0.25 && max > 20.0 * median).then_some((share, at))
+    }
+
+    /// Fills every bin not `picked` from `coarse` (the same rays per bin, any grid of the
+    /// same kind): the values of the coarse bin holding its centre ([`containing_bin`]).
+    pub fn fill_from(&mut self, coarse: &Distribution, picked: &[bool]) {
+        assert_eq!(self.nsamps, coarse.nsamps, "rays per bin differ");
+        for (k, &p) in picked.iter().enumerate() {
+            if !p {
+                let c = containing_bin(k, (self.nalt, self.nazi), (coarse.nalt, coarse.nazi));
+                self.sums[k] = coarse.sums[c];
+                self.sumsq[k] = coarse.sumsq[c];
+            }
+        }
     }
 
     /// Standard error of each bin's mean luminance (from its rays' spread).
@@ -102,6 +121,33 @@ impl Distribution {
         let b = crate::bright(v);
         self.sumsq[k] += b * b;
     }
+}
+
+/// The bin of a `coarse` grid (altitude, azimuth divisions) holding the centre of bin `k`
+/// of a `fine` grid. Both kinds of grid (hemisphere, sphere) are uniform in their altitude
+/// coordinate and in azimuth, azimuth bin `j` centred on `j / nazi` of a turn.
+pub fn containing_bin(k: usize, fine: (usize, usize), coarse: (usize, usize)) -> usize {
+    let (a, z) = (k / fine.1, k % fine.1);
+    let alt = (a as f64 + 0.5) / fine.0 as f64;
+    let azi = z as f64 / fine.1 as f64;
+    let i = ((alt * coarse.0 as f64) as usize).min(coarse.0 - 1);
+    let j = ((azi * coarse.1 as f64 + 0.5) as usize) % coarse.1;
+    i * coarse.1 + j
+}
+
+/// Bin `k` of an `nalt × nazi` grid and its neighbours: one row up and down, one bin
+/// either way in azimuth (wrapping), and the whole of a row at a pole (its bins all meet
+/// there; a sphere has a pole at each end).
+pub fn neighbourhood(k: usize, (nalt, nazi): (usize, usize), sphere: bool) -> Vec<bool> {
+    let (a, z) = (k / nazi, k % nazi);
+    let pole = |i: usize| i == 0 || (sphere && i + 1 == nalt);
+    (0..nalt * nazi)
+        .map(|q| {
+            let (i, j) = (q / nazi, q % nazi);
+            let dz = j.abs_diff(z).min(nazi - j.abs_diff(z));
+            i.abs_diff(a) <= 1 && (dz <= 1 || pole(i))
+        })
+        .collect()
 }
 
 /// A unit direction uniform in projected solid angle: `alt` is sin²θ, `azi` a turn fraction.
@@ -157,11 +203,27 @@ pub struct Job<'a> {
     pub nsamps: usize,
     /// Add light sources explicitly (`l+`).
     pub light: bool,
+    /// The bins to sample (None: all); the others are left empty, for the caller to fill.
+    pub only: Option<Vec<bool>>,
     /// Progress (one unit per ray), if shown.
     pub progress: Option<&'a fenestra_cli::progress::Progress>,
 }
 
 impl Job<'_> {
+    /// Whether bin `k` is sampled.
+    fn picked(&self, k: usize) -> bool {
+        self.only.as_ref().is_none_or(|m| m[k])
+    }
+
+    /// Rays traced: `nsamps` for each bin sampled.
+    pub fn rays(&self) -> usize {
+        let bins = match &self.only {
+            Some(m) => m.iter().filter(|&&p| p).count(),
+            None => self.nalt * self.nazi,
+        };
+        bins * self.nsamps
+    }
+
     /// Counts `n` rays done.
     pub fn tick(&self, n: u64) {
         if let Some(p) = self.progress {
@@ -213,6 +275,9 @@ impl Job<'_> {
             }
             let l = -l;
             let k = flatindex(l, self.nalt, self.nazi);
+            if !self.picked(k) {
+                continue;
+            }
             let d = scale * l.z * s.omega;
             for c in 0..3 {
                 dist.sums[k][c] += s.value[c] * d;
@@ -245,6 +310,7 @@ pub fn face(job: &Job, f: &Face) -> Option<Distribution> {
     };
     let rays: Vec<(usize, [f64; 3], usize)> = (0..n * s)
         .into_par_iter()
+        .filter(|idx| job.picked(idx / s))
         .map(|idx| {
             let (k, i, mut rng, id) = job.start_ray(idx);
             let [x, y, s0, s1] = job.cell_point(k, i, &mut rng);
@@ -262,7 +328,7 @@ pub fn face(job: &Job, f: &Face) -> Option<Distribution> {
         })
         .collect();
     let fails: usize = rays.iter().map(|r| r.2).sum();
-    if fails > 5 * n * s {
+    if fails > 5 * rays.len() {
         return None;
     }
     let mut dist = Distribution::new(job.nalt, job.nazi, s);
@@ -287,6 +353,7 @@ pub fn ring(job: &Job, r: &Ring) -> Distribution {
     let eps = R_EPS * r.r1;
     let rays: Vec<(usize, [f64; 3])> = (0..n * s)
         .into_par_iter()
+        .filter(|idx| job.picked(idx / s))
         .map(|idx| {
             let (k, i, mut rng, id) = job.start_ray(idx);
             let [x, y, s0, s1] = job.cell_point(k, i, &mut rng);
@@ -316,6 +383,7 @@ pub fn sphere(job: &Job, centre: DVec3, radius: f64) -> Distribution {
     let s = job.nsamps;
     let rays: Vec<(usize, [f64; 3])> = (0..n * s)
         .into_par_iter()
+        .filter(|idx| job.picked(idx / s))
         .map(|idx| {
             let (k, i, mut rng, id) = job.start_ray(idx);
             let [p0, p1, s0, s1] = job.cell_point(k, i, &mut rng);
@@ -382,6 +450,46 @@ mod tests {
                 "coordinate {d}: variance {v}"
             );
         }
+    }
+
+    #[test]
+    fn coarse_bins_hold_the_fine_bins_centres() {
+        // d=48 and d=192 (4x): every fine bin's centre lies in the coarse bin found for it
+        // (every other fine azimuth centre lies on a coarse boundary: either side will do)
+        let (coarse, fine) = ((7, 22), (14, 44));
+        for k in 0..fine.0 * fine.1 {
+            let c = containing_bin(k, fine, coarse);
+            let (a, z) = (k / fine.1, k % fine.1);
+            let alt = (a as f64 + 0.5) / fine.0 as f64;
+            let sides: Vec<usize> = [-1e-9, 0.0, 1e-9]
+                .iter()
+                .map(|e| {
+                    flatindex(
+                        flatdir(alt, z as f64 / fine.1 as f64 + e),
+                        coarse.0,
+                        coarse.1,
+                    )
+                })
+                .collect();
+            assert!(sides.contains(&c), "fine bin {k}: {c} not in {sides:?}");
+            if z % 2 == 0 {
+                assert!(
+                    sides.iter().all(|&x| x == c),
+                    "fine bin {k}: {c}, {sides:?}"
+                );
+            }
+        }
+        // the neighbourhood: 3 x 3 bins away from the pole (wrapping in azimuth), a whole
+        // row at the pole
+        let m = neighbourhood(3 * 22, (7, 22), false);
+        let picked: Vec<usize> = (0..m.len()).filter(|&q| m[q]).collect();
+        assert_eq!(picked, [44, 45, 65, 66, 67, 87, 88, 89, 109]);
+        let m = neighbourhood(1, (7, 22), false);
+        assert_eq!(m.iter().filter(|&&p| p).count(), 22 + 3);
+        assert!(m[22] && m[23] && m[24] && !m[25]);
+        // a sphere's last row is a pole too
+        let m = neighbourhood(6 * 22 + 5, (7, 22), true);
+        assert_eq!(m.iter().filter(|&&p| p).count(), 22 + 3);
     }
 
     #[test]
