@@ -64,6 +64,44 @@ fn oracle_getinfo_outputs_are_identical() {
     cmp(&["-d", "-"], Some(&data));
 }
 
+/// `getinfo [+d|-d] -c command ..`: the header with the command line added (quoted as
+/// Radiance quotes words), the resolution string kept or dropped, then the command's output
+/// on the data: byte-identical with the oracle's (each side's own rcalc on its PATH).
+#[test]
+fn oracle_getinfo_c_runs_the_command_on_the_data() {
+    let Some(o) = common::oracle() else { return };
+    let base = common::fixture("threephase");
+    let ours_dir = common::fenestra("getinfo").get_program().to_owned();
+    let ours_dir = Path::new(&ours_dir).parent().unwrap().to_owned();
+    let path = format!(
+        "{}:{}",
+        ours_dir.display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    let pic = std::fs::read(base.join("img_t1_mar21_1000_clear.hdr")).unwrap();
+    let text = b"#?RADIANCE\nA=1\nFORMAT=ascii\n\n1 2\n3 4\n".to_vec();
+    let cases: [(&[&str], &[u8]); 5] = [
+        (&["-c", "cat"], &pic),
+        (&["+d", "-c", "head", "-c", "100"], &pic),
+        (&["-d", "-c", "head", "-c", "100"], &pic),
+        (&["-c", "rcalc", "-e", "$1=$1*2"], &text),
+        (&["-c", "echo", "a b", "it's", "say \"hi\"", ""], &text),
+    ];
+    for (args, input) in cases {
+        let a = run(o.command("getinfo"), &base, args, Some(input));
+        let mut c = common::fenestra("getinfo");
+        c.env("PATH", &path);
+        let b = run(c, &base, args, Some(input));
+        assert!(a.status.success() && b.status.success(), "getinfo {args:?}");
+        assert!(
+            a.stdout == b.stdout,
+            "getinfo {args:?}:\n{}\n---\n{}",
+            String::from_utf8_lossy(&a.stdout),
+            String::from_utf8_lossy(&b.stdout)
+        );
+    }
+}
+
 /// The reference workflow `rmtxop … | getinfo - | total` needs the data bytes unchanged.
 #[test]
 fn strip_keeps_binary_data_exactly() {

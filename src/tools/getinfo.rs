@@ -19,6 +19,10 @@ Usage:
                            or a matrix's shape ('file: NROWS=r NCOLS=c NCOMP=n')
   getinfo -d               the same for the standard input
   getinfo -d -             copy a picture from the standard input without header and resolution
+  getinfo [+d|-d] -c command args ..
+                           print the standard input's header with the command line added, then
+                           run the command on the data (+d: the picture resolution string kept
+                           in the header's place, -d: dropped)
 ";
 
 /// Runs getinfo.
@@ -33,6 +37,15 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     }
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::with_capacity(1 << 16, stdout.lock());
+    // [+d|-d] -c command ..: the header, then the command run on the data
+    let (dim, after) = match rest.first().map(String::as_str) {
+        Some("+d") => (Some(true), &rest[1..]),
+        Some("-d") if rest.get(1).is_some_and(|a| a == "-c") => (Some(false), &rest[1..]),
+        _ => (None, rest),
+    };
+    if after.len() > 1 && after[0] == "-c" {
+        return run_command(&mut out, dim, &after[1..]);
+    }
     let ok = match rest.first().map(String::as_str) {
         None => {
             let mut r = stdin_reader();
@@ -125,6 +138,54 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
     } else {
         ExitCode::from(1)
     })
+}
+
+/// `getinfo [+d|-d] -c command ..`: the standard input's header with the command line
+/// added (before the FORMAT line, as `-a`), the picture resolution string copied (`+d`,
+/// `Some(true)`) or dropped (`-d`), then `command` run with the rest of the input as its
+/// standard input and its output after the header; exits with the command's status.
+fn run_command(out: &mut impl Write, dim: Option<bool>, command: &[String]) -> Result<ExitCode> {
+    let mut r = stdin_reader();
+    let h = Header::read(&mut r, "<stdin>")?;
+    for l in h.lines.iter().filter(|l| !l.starts_with("FORMAT=")) {
+        writeln!(out, "{l}")?;
+    }
+    let words: Vec<String> = command
+        .iter()
+        .map(|w| fenestra_cli::quote_word(w))
+        .collect();
+    writeln!(out, "{}", words.join(" "))?;
+    if let Some(f) = h.format() {
+        writeln!(out, "FORMAT={f}")?;
+    }
+    writeln!(out)?;
+    if let Some(keep) = dim {
+        let res = read_resolution(&mut r, "<stdin>")?;
+        if keep {
+            writeln!(out, "{}", res.to_string().trim_end())?;
+        }
+    }
+    out.flush()?;
+    let mut child = std::process::Command::new(&command[0])
+        .args(&command[1..])
+        .stdin(std::process::Stdio::piped())
+        .spawn()
+        .with_context(|| format!("cannot run '{}'", command[0]))?;
+    let mut input = child.stdin.take().expect("piped standard input");
+    // a command that stops reading early (head) closes the pipe: not an error here
+    let copied = std::io::copy(&mut r, &mut input);
+    drop(input);
+    let status = child
+        .wait()
+        .with_context(|| format!("'{}' did not finish", command[0]))?;
+    if let Err(e) = copied {
+        if e.kind() != std::io::ErrorKind::BrokenPipe {
+            return Err(e).context("cannot pass the data on");
+        }
+    }
+    Ok(ExitCode::from(
+        status.code().map_or(1, |c| u8::try_from(c).unwrap_or(1)),
+    ))
 }
 
 fn stdin_reader() -> BufReader<std::io::StdinLock<'static>> {

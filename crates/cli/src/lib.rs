@@ -15,6 +15,6 @@ pub mod threads;
 pub use threads::{peak_memory_line, peak_rss_kb};
 
 pub use run::{
-    command_line, help_asked, main_with, main_with_args, prog, set_prog, set_warnings, warn,
-    warn_note, warnings_on, Exit,
+    command_line, help_asked, main_with, main_with_args, prog, quote_word, set_prog, set_warnings,
+    warn, warn_note, warnings_on, Exit,
 };

@@ -96,15 +96,26 @@ pub fn command_line(args: &[String]) -> String {
     out
 }
 
-fn quote_word(w: &str) -> String {
-    let needs = w.is_empty() || w.chars().any(|c| c.is_whitespace());
-    if !needs {
-        return w.to_string();
+/// A word as Radiance's `fputword` writes it: quoted when empty, when it holds white
+/// space, or when a quote mark stands inside it (not first, not last); in single quotes
+/// when the last such inner mark is a double quote, else in double quotes.
+pub fn quote_word(w: &str) -> String {
+    let b = w.as_bytes();
+    let mut quote = None;
+    for (i, &c) in b.iter().enumerate() {
+        if i > 0 && i + 1 < b.len() {
+            if c == b'"' {
+                quote = Some('\'');
+            } else if c == b'\'' {
+                quote = Some('"');
+            }
+        }
     }
-    if w.contains('"') {
-        format!("'{w}'")
-    } else {
-        format!("\"{w}\"")
+    let space = b.iter().any(|c| c.is_ascii_whitespace() || *c == 0x0b);
+    match (w.is_empty() || space, quote) {
+        (_, Some(q)) => format!("{q}{w}{q}"),
+        (true, None) => format!("\"{w}\""),
+        (false, None) => w.to_string(),
     }
 }
 
@@ -129,5 +140,17 @@ mod tests {
             .map(|s| s.to_string())
             .collect();
         assert_eq!(command_line(&args), "rmtxop -c \"a b\" \"\" 'x\"y z'");
+    }
+
+    #[test]
+    fn words_are_quoted_as_radiance_s_fputword() {
+        // an inner quote mark (not first, not last) quotes with the other mark; a quote
+        // mark at either end alone does not
+        assert_eq!(quote_word("it's"), "\"it's\"");
+        assert_eq!(quote_word("say \"hi\""), "'say \"hi\"'");
+        assert_eq!(quote_word("\"a\""), "\"a\"");
+        assert_eq!(quote_word("a'"), "a'");
+        assert_eq!(quote_word("$1=$1*2"), "$1=$1*2");
+        assert_eq!(quote_word("a\tb"), "\"a\tb\"");
     }
 }
