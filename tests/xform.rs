@@ -5,18 +5,17 @@ mod common;
 use std::process::Command;
 
 fn body(out: &[u8]) -> String {
-    // Header lines ("# /path/to/xform args", one per array copy) name the program by its
-    // path, which differs between the tools: keep only the arguments.
+    // Header lines ("# /path/to/xform args", one per array copy) and the commands -c keeps
+    // ("!cmd | /path/to/xform args") name the program by its path, which differs between
+    // the tools: the program's name only.
     String::from_utf8_lossy(out)
         .lines()
         .map(|l| {
-            match l
-                .strip_prefix("# ")
-                .and_then(|r| r.split_once(' ').or(Some((r, ""))))
-            {
-                Some((prog, rest)) if prog.ends_with("/xform") => format!("# xform {rest}\n"),
-                _ => format!("{l}\n"),
-            }
+            let words: Vec<&str> = l
+                .split(' ')
+                .map(|w| if w.ends_with("/xform") { "xform" } else { w })
+                .collect();
+            format!("{}\n", words.join(" "))
         })
         .collect()
 }
@@ -32,6 +31,13 @@ const TRANSFORMS: &[&str] = &[
     "-a 2 -t 1 0 0 -a 3 -t 0 1 0",
     "-ry 33.3 -s .7 -my -t .1 .2 .3",
     "-rx -20 -ry 45.5 -rz 181 -s 1e-3 -t 1000 -2000 .5",
+    // the tool options go into the header as given (order, repeats, -e), a second -n
+    // extends the name prefix, an array element's name takes the last -n's place
+    "-e -rz 90",
+    "-I -n pre -c -rz 90",
+    "-m mat -e -c -n a -n b -t 1 2 3",
+    "-c -e -I -I -s 2",
+    "-c -n pre -I -a 2 -t 1 0 0",
 ];
 
 fn files() -> Vec<std::path::PathBuf> {

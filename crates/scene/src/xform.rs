@@ -27,6 +27,10 @@ pub struct XformOptions {
     pub expand: bool,
     /// The transform words (`-t … -rx … -i N -a N …`).
     pub xf_words: Vec<String>,
+    /// The tool options as given, in order, with their values (the header repeats them).
+    pub given: Vec<(String, Option<String>)>,
+    /// A run of one array element (its `name` is the element's, for the header).
+    pub element: bool,
 }
 
 /// Types whose string arguments end with an (appended) transform.
@@ -85,14 +89,21 @@ impl XformOptions {
                         .ok_or_else(|| anyhow!("option {} needs a value", args[i]))?
                         .clone();
                     if args[i] == "-n" {
-                        o.name = Some(v);
+                        // a second -n extends the prefix (Radiance's: -n a -n b names a.b.x)
+                        o.name = Some(match o.name.take() {
+                            Some(prev) => format!("{prev}.{v}"),
+                            None => v.clone(),
+                        });
                     } else {
-                        o.modifier = Some(v);
+                        o.modifier = Some(v.clone());
                     }
-                    i += 1;
+                    o.given.push((args[i].clone(), Some(v)));
+                    i += 2;
+                    continue;
                 }
                 _ => break,
             }
+            o.given.push((args[i].clone(), None));
             i += 1;
         }
         while i < args.len() {
@@ -114,8 +125,37 @@ impl XformOptions {
         Ok((o, args[i..].to_vec()))
     }
 
-    /// The words after the program name in the header (tool options, then transform).
+    /// The words after the program name in the header: the tool options as given (as
+    /// Radiance's: in their order, repeats kept; an array element's name in place of the
+    /// last `-n` value, or first when there was none), then the transform.
     fn header_words(&self) -> Vec<String> {
+        if self.given.is_empty() {
+            return self.synthesised_header_words();
+        }
+        let mut w = Vec::new();
+        let last_n = self
+            .given
+            .iter()
+            .rposition(|(o, _)| o == "-n")
+            .filter(|_| self.element);
+        if let (None, true, Some(n)) = (last_n, self.element, &self.name) {
+            w.push("-n".into());
+            w.push(n.clone());
+        }
+        for (k, (o, v)) in self.given.iter().enumerate() {
+            w.push(o.clone());
+            match v {
+                Some(_) if Some(k) == last_n => w.push(self.name.clone().unwrap_or_default()),
+                Some(v) => w.push(v.clone()),
+                None => {}
+            }
+        }
+        w.extend(self.xf_words.iter().cloned());
+        w
+    }
+
+    /// Header words of options not parsed from a command line: the options that are set.
+    fn synthesised_header_words(&self) -> Vec<String> {
         let mut w = Vec::new();
         if let Some(n) = &self.name {
             w.push("-n".into());
@@ -206,6 +246,7 @@ impl Iterator for ArrayRuns<'_> {
             let _ = write!(name, ".{k}");
         }
         run.name = Some(name);
+        run.element = true;
         for (d, (pos, _)) in self.arrays.iter().enumerate() {
             run.xf_words[*pos] = "-i".into();
             run.xf_words[*pos + 1] = idx[d].to_string();
@@ -493,11 +534,12 @@ impl Xformer<'_> {
             }
             "ring" => {
                 row(out, &xf.point(p3(&rargs, 0)));
-                let mut n = p3(&rargs, 3);
+                // negated after the transform, as Radiance (the sign of a zero shows)
+                let mut n = xf.vector(p3(&rargs, 3));
                 if flip {
-                    n = [-n[0], -n[1], -n[2]];
+                    n = n.map(|x| -x);
                 }
-                row(out, &xf.vector(n));
+                row(out, &n);
                 row(out, &[rargs[6] * sca, rargs[7] * sca]);
             }
             "glow" => {
