@@ -180,3 +180,35 @@ fn oracle_vwrays_stdin_positions() {
     c.args(args);
     assert_eq!(with_stdin(c, input), want);
 }
+
+/// A view so wide that the aspect adjustment leaves no row (or column): Radiance prints
+/// the empty resolution with -d, no rays otherwise, and succeeds; so do we (with a
+/// warning). Pixel positions read with -i would give NaN rays there: that stays an error.
+#[test]
+fn oracle_vwrays_resolution_reduced_to_nothing() {
+    let Some(o) = common::oracle() else { return };
+    for args in [
+        &["-x", "100", "-y", "1", "-vtv", "-vh", "90", "-vv", "0.1"][..],
+        &[
+            "-x", "100", "-y", "1", "-vtv", "-vh", "90", "-vv", "0.1", "-d",
+        ],
+        &[
+            "-x", "1", "-y", "100", "-vtv", "-vh", "0.1", "-vv", "90", "-d",
+        ],
+    ] {
+        let theirs = common::run_ok(o.command("vwrays").args(args));
+        assert_eq!(ours(args), theirs, "vwrays {args:?}");
+    }
+    let out = common::run_stdin(
+        {
+            let mut c = common::fenestra("vwrays");
+            c.args([
+                "-i", "-x", "100", "-y", "1", "-vtv", "-vh", "90", "-vv", "0.1",
+            ]);
+            c
+        },
+        b"5 0\n",
+    );
+    assert!(!out.status.success() && out.stdout.is_empty());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("100 x 0"));
+}
