@@ -87,6 +87,18 @@ fn oracle_getinfo_c_runs_the_command_on_the_data() {
         (&["-c", "rcalc", "-e", "$1=$1*2"], &text),
         (&["-c", "echo", "a b", "it's", "say \"hi\"", ""], &text),
     ];
+    // the command's exit status is getinfo's; a command that cannot start is an error
+    let status = |c: Command| run(c, &base, &["-c", "sh", "-c", "exit 3"], Some(&text)).status;
+    assert_eq!(status(o.command("getinfo")).code(), Some(3));
+    assert_eq!(status(common::fenestra("getinfo")).code(), Some(3));
+    let missing = run(
+        common::fenestra("getinfo"),
+        &base,
+        &["-c", "no-such-command-here"],
+        Some(&text),
+    );
+    assert_eq!(missing.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&missing.stderr).contains("cannot run 'no-such-command-here'"));
     for (args, input) in cases {
         let a = run(o.command("getinfo"), &base, args, Some(input));
         let mut c = common::fenestra("getinfo");

@@ -249,7 +249,7 @@ fn oracle_sobol_bins_are_less_noisy_than_radiance_s() {
     // The reference glass window (its directive, d=100), four runs of each: Radiance's
     // mkillum at s=32 (its runs are seeded differently each time), ours at s=32 and at
     // s=16 (-seed 1..4). Noise: each direction's spread over the four runs, relative rms
-    // over the 310 directions. Measured: Radiance 4.48%, ours 1.92% at s=32 and 2.82% at
+    // over the 310 directions. Measured: Radiance 4.41-4.48%, ours 1.92% at s=32 and 2.82% at
     // s=16 (each figure's own uncertainty, from 310 three-degree-of-freedom variances, is a
     // few per cent of it). Checked: ours at s=32 below 0.7 × Radiance's and at s=16 below
     // 0.9 × (the speed claim at equal error rests on it), and the totals over the
@@ -504,7 +504,7 @@ fn a_peak_in_the_distribution_is_reported() {
             let err = String::from_utf8_lossy(&out.stderr);
             assert!(err.contains("at d=6: sampled again at d=24 (p+)"), "{err}");
             assert!(!err.contains("raise d="), "{err}");
-            // the data file holds the finer grid: 80 directions at d=24 or 300 at d=96
+            // the data file holds the finer grid: 80 directions at d=24 or 310 at d=96
             // (the pole row added), not 12
             let (grid, _) = datafile(&d.join("fineR.dat"));
             let cells: usize = grid.iter().map(|g| g.2).product();

@@ -182,8 +182,9 @@ fn oracle_vwrays_stdin_positions() {
 }
 
 /// A view so wide that the aspect adjustment leaves no row (or column): Radiance prints
-/// the empty resolution with -d, no rays otherwise, and succeeds; so do we (with a
-/// warning). Pixel positions read with -i would give NaN rays there: that stays an error.
+/// the empty resolution with -d (with -ld+ for a view with an aft plane, and also with -i),
+/// no rays otherwise, and succeeds; so do we (with a warning). Pixel positions read with -i
+/// would give NaN rays there: that stays an error.
 #[test]
 fn oracle_vwrays_resolution_reduced_to_nothing() {
     let Some(o) = common::oracle() else { return };
@@ -194,6 +195,12 @@ fn oracle_vwrays_resolution_reduced_to_nothing() {
         ],
         &[
             "-x", "1", "-y", "100", "-vtv", "-vh", "0.1", "-vv", "90", "-d",
+        ],
+        &[
+            "-x", "100", "-y", "1", "-vtv", "-vh", "90", "-vv", "0.1", "-d", "-i",
+        ],
+        &[
+            "-x", "100", "-y", "1", "-vtv", "-vh", "90", "-vv", "0.1", "-va", "3", "-d",
         ],
     ] {
         let theirs = common::run_ok(o.command("vwrays").args(args));

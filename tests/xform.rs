@@ -32,12 +32,16 @@ const TRANSFORMS: &[&str] = &[
     "-ry 33.3 -s .7 -my -t .1 .2 .3",
     "-rx -20 -ry 45.5 -rz 181 -s 1e-3 -t 1000 -2000 .5",
     // the tool options go into the header as given (order, repeats, -e), a second -n
-    // extends the name prefix, an array element's name takes the last -n's place
+    // extends the name prefix, an array element's name takes the -n values' place
     "-e -rz 90",
     "-I -n pre -c -rz 90",
     "-m mat -e -c -n a -n b -t 1 2 3",
     "-c -e -I -I -s 2",
     "-c -n pre -I -a 2 -t 1 0 0",
+    // the first -m counts; with an array every -n value becomes the element's name (from
+    // the last -n), each extending the prefix: q.0.q.0.x (Radiance's, reproduced)
+    "-m a -m b -rz 1",
+    "-n p -n q -a 2 -t 1 0 0",
 ];
 
 fn files() -> Vec<std::path::PathBuf> {

@@ -125,17 +125,24 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         None => {
             normaspect(view.aspect(), &mut pa, &mut xres, &mut yres);
             if xres <= 0 || yres <= 0 {
-                // Radiance prints the empty resolution (-d) or no rays, and succeeds; rays
-                // for pixel positions read (-i) would be NaN there, so that stays an error
+                // Radiance prints the empty resolution (-d, even with -i) or no rays, and
+                // succeeds; rays for pixel positions read (-i) would be NaN there, so that
+                // stays an error
+                if getdim {
+                    println!(
+                        "-x {} -y {}{}",
+                        xres.max(0),
+                        yres.max(0),
+                        if view.vaft > FTINY { " -ld+" } else { "" }
+                    );
+                    return Ok(ExitCode::SUCCESS);
+                }
                 if from_stdin {
                     bail!("view aspect reduces the resolution to {xres} x {yres}");
                 }
                 fenestra_cli::warn(format!(
                     "view aspect reduces the resolution to {xres} x {yres}: no rays"
                 ));
-                if getdim {
-                    println!("-x {} -y {}", xres.max(0), yres.max(0));
-                }
                 return Ok(ExitCode::SUCCESS);
             }
             Resolution::standard(xres as usize, yres as usize)

@@ -115,10 +115,16 @@ pub fn face(
     let s = job.nsamps;
     let ni = bsdf.incident.len();
     let eps = 0.005 * f.area.sqrt();
-    let point = |rng: &mut fenestra_trace::rng::Rng| -> Option<DVec3> {
-        for _ in 0..1000 {
-            let a = f.ur[0] + (f.ur[1] - f.ur[0]) * rng.next_f64();
-            let b = f.vr[0] + (f.vr[1] - f.vr[0]) * rng.next_f64();
+    // a point uniform over the window: the first candidate from (x, y) in [0,1)² over its
+    // (u, v) box, later ones (rejection) from `rng`
+    let point = |(x, y): (f64, f64), rng: &mut fenestra_trace::rng::Rng| -> Option<DVec3> {
+        let (mut x, mut y) = (x, y);
+        for t in 0..1000 {
+            if t > 0 {
+                (x, y) = (rng.next_f64(), rng.next_f64());
+            }
+            let a = f.ur[0] + (f.ur[1] - f.ur[0]) * x;
+            let b = f.vr[0] + (f.vr[1] - f.vr[0]) * y;
             if f.contains(a, b) {
                 return Some(f.point(a, b) - eps * n);
             }
@@ -130,10 +136,12 @@ pub fn face(
         .into_par_iter()
         .map(|idx| {
             let (i, k, mut rng, id) = job.start_ray(idx);
-            let (s0, s1) = stratified2(k, s, &mut rng);
+            // start point and direction within the patch stratified jointly (as the
+            // traced mode's bins)
+            let [x, y, s0, s1] = job.cell_point(i, k, &mut rng);
             let l = bsdf.incident.sample_projected(i, s0, s1)?;
             let dir = -(l[0] * u + l[1] * v + l[2] * n);
-            let org = point(&mut rng)?;
+            let org = point((x, y), &mut rng)?;
             Some((i, job.tracer.radiance_specular(id, org, dir)))
         })
         .collect();
@@ -164,7 +172,7 @@ pub fn face(
             let org = if f.contains(a, b) {
                 f.point(a, b) - eps * n
             } else {
-                point(&mut rng)?
+                point((rng.next_f64(), rng.next_f64()), &mut rng)?
             };
             let mut out = Vec::new();
             for src in job.tracer.source_light(id, org) {
@@ -221,6 +229,7 @@ pub fn face(
         nazi,
         nsamps: 1,
         sumsq: vec![0.0; sums.len()],
+        lights: vec![[0.0; 3]; sums.len()],
         sums,
     };
     Ok(Some((d, axes)))

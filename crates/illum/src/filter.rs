@@ -357,10 +357,17 @@ impl<'a> Filter<'a> {
                     if let Some(pr) = self.progress {
                         pr.restart(fine.rays() as u64, &format!("mkillum {}", p.name));
                     }
-                    let Some((mut finer, _)) = self.sample_traced(p, name, out, &fine)? else {
-                        return Ok(());
+                    // origins that cannot be placed this time keep the distribution so far
+                    let Some(mut finer) = self.sample_refined(p, name, &fine)? else {
+                        warn(format!(
+                            "{} \"{}\": refinement at d={} failed (bad aspect): kept d={dens}",
+                            p.ptype,
+                            p.name,
+                            dens * 4
+                        ));
+                        break peak.map(|(share, _)| share);
                     };
-                    finer.fill_from(&dist, &picked);
+                    finer.fill_from(&dist, &picked, &around);
                     dist = finer;
                     dens *= 4;
                 }
@@ -392,6 +399,7 @@ impl<'a> Filter<'a> {
             nsamps,
             light: self.settings.light,
             only: None,
+            level,
             progress: self.progress,
         };
         if let Some(pr) = self.progress {
@@ -402,6 +410,32 @@ impl<'a> Filter<'a> {
             pr.restart(rays as u64, &format!("mkillum {}", p.name));
         }
         job
+    }
+
+    /// A `p+` refinement's distribution of `p` (already sampled once, so its kind and
+    /// geometry are good), or `None` when its origins could not be placed.
+    fn sample_refined(
+        &self,
+        p: &Prim,
+        name: &str,
+        job: &Job,
+    ) -> Result<Option<crate::sample::Distribution>> {
+        Ok(match p.ptype.as_str() {
+            "polygon" => {
+                let face = Face::new(&p.rargs)
+                    .map_err(|e| anyhow::anyhow!("({name}): polygon \"{}\": {e}", p.name))?;
+                face.and_then(|f| sample::face(job, &f))
+            }
+            "ring" => {
+                let r = Ring::new(&p.rargs)
+                    .map_err(|e| anyhow::anyhow!("({name}): ring \"{}\": {e}", p.name))?;
+                Some(sample::ring(job, &r))
+            }
+            _ => {
+                let c = glam::DVec3::new(p.rargs[0], p.rargs[1], p.rargs[2]);
+                Some(sample::sphere(job, c, p.rargs[3]))
+            }
+        })
     }
 
     /// The traced mode's distribution of `p` (with its axes), or `None` when the surface

@@ -35,6 +35,8 @@ pub struct Distribution {
     pub sums: Vec<[f64; 3]>,
     /// Sum of squared luminance of the bin's sample rays (for the standard error).
     pub sumsq: Vec<f64>,
+    /// The part of `sums` the light sources added explicitly (`l+`).
+    pub lights: Vec<[f64; 3]>,
 }
 
 impl Distribution {
@@ -46,6 +48,7 @@ impl Distribution {
             nsamps,
             sums: vec![[0.0; 3]; nalt * nazi],
             sumsq: vec![0.0; nalt * nazi],
+            lights: vec![[0.0; 3]; nalt * nazi],
         }
     }
 
@@ -84,16 +87,46 @@ impl Distribution {
         (share > 0.25 && max > 20.0 * median).then_some((share, at))
     }
 
-    /// Fills every bin not `picked` from `coarse` (the same rays per bin, any grid of the
-    /// same kind): the values of the coarse bin holding its centre ([`containing_bin`]).
-    pub fn fill_from(&mut self, coarse: &Distribution, picked: &[bool]) {
+    /// Fills every bin not `picked` from `coarse` (the same rays per bin, a coarser grid
+    /// of the same kind) outside its bins `resampled` (those `picked` replaces): its rays'
+    /// part is the mean of those coarse bins' over the area it shares with each
+    /// ([`overlaps`], renormalised: a resampled coarse bin's light, the peak's, must not
+    /// leak out of the refined directions), its light sources' part (`lights`, `l+`) its
+    /// own, drawn at this resolution.
+    pub fn fill_from(&mut self, coarse: &Distribution, picked: &[bool], resampled: &[bool]) {
         assert_eq!(self.nsamps, coarse.nsamps, "rays per bin differ");
+        let fine = (self.nalt, self.nazi);
+        let grid = (coarse.nalt, coarse.nazi);
         for (k, &p) in picked.iter().enumerate() {
-            if !p {
-                let c = containing_bin(k, (self.nalt, self.nazi), (coarse.nalt, coarse.nazi));
-                self.sums[k] = coarse.sums[c];
-                self.sumsq[k] = coarse.sumsq[c];
+            if p {
+                continue;
             }
+            let all = overlaps(k, fine, grid);
+            let mut o: Vec<(usize, f64)> = all
+                .iter()
+                .copied()
+                .filter(|&(c, _)| !resampled[c])
+                .collect();
+            // (a bin not picked has its centre in a coarse bin not resampled, so some of
+            // its area lies there; kept whole should rounding say otherwise)
+            if o.iter().map(|x| x.1).sum::<f64>() <= 0.0 {
+                o = all;
+            }
+            let total: f64 = o.iter().map(|x| x.1).sum();
+            let mut sum = self.lights[k];
+            let mut sq = 0.0;
+            for (c, w) in o {
+                let w = w / total;
+                let rays = std::array::from_fn::<f64, 3, _>(|ch| {
+                    coarse.sums[c][ch] - coarse.lights[c][ch]
+                });
+                for (s, r) in sum.iter_mut().zip(rays) {
+                    *s += w * r;
+                }
+                sq += w * coarse.sumsq[c];
+            }
+            self.sums[k] = sum;
+            self.sumsq[k] = sq;
         }
     }
 
@@ -121,18 +154,60 @@ impl Distribution {
         let b = crate::bright(v);
         self.sumsq[k] += b * b;
     }
+
+    /// Adds light `v` of a source sample to bin `k`.
+    fn add_light(&mut self, k: usize, v: [f64; 3]) {
+        for ((s, l), x) in self.sums[k].iter_mut().zip(&mut self.lights[k]).zip(v) {
+            *s += x;
+            *l += x;
+        }
+    }
 }
 
 /// The bin of a `coarse` grid (altitude, azimuth divisions) holding the centre of bin `k`
 /// of a `fine` grid. Both kinds of grid (hemisphere, sphere) are uniform in their altitude
-/// coordinate and in azimuth, azimuth bin `j` centred on `j / nazi` of a turn.
+/// coordinate and in azimuth, azimuth bin `j` centred on `j / nazi` of a turn. Exact
+/// (integer) arithmetic: a centre on a coarse boundary always goes to the upper bin.
 pub fn containing_bin(k: usize, fine: (usize, usize), coarse: (usize, usize)) -> usize {
     let (a, z) = (k / fine.1, k % fine.1);
-    let alt = (a as f64 + 0.5) / fine.0 as f64;
-    let azi = z as f64 / fine.1 as f64;
-    let i = ((alt * coarse.0 as f64) as usize).min(coarse.0 - 1);
-    let j = ((azi * coarse.1 as f64 + 0.5) as usize) % coarse.1;
+    // altitude (a + ½)/Fa in row ⌊(2a + 1)·Ca / (2·Fa)⌋; azimuth z/Fz nearest to column
+    // ⌊(2·z·Cz + Fz) / (2·Fz)⌋, wrapped
+    let i = ((2 * a + 1) * coarse.0 / (2 * fine.0)).min(coarse.0 - 1);
+    let j = ((2 * z * coarse.1 + fine.1) / (2 * fine.1)) % coarse.1;
     i * coarse.1 + j
+}
+
+/// The coarse bins that bin `k` of a `fine` grid overlaps, each with the fraction of the
+/// fine bin's area it holds (the fractions sum to 1). Areas are measured in the grids'
+/// coordinates (altitude coordinate × azimuth turns), in which bins of one grid are equal.
+pub fn overlaps(k: usize, fine: (usize, usize), coarse: (usize, usize)) -> Vec<(usize, f64)> {
+    let (a, z) = (k / fine.1, k % fine.1);
+    let (f0, f1) = (fine.0 as f64, fine.1 as f64);
+    let (c0, c1) = (coarse.0 as f64, coarse.1 as f64);
+    // the fine bin: altitude [a, a + 1)/Fa, azimuth [z − ½, z + ½)/Fz (turns)
+    let (alo, ahi) = (a as f64 / f0, (a + 1) as f64 / f0);
+    let (zlo, zhi) = ((z as f64 - 0.5) / f1, (z as f64 + 0.5) / f1);
+    let mut out = Vec::new();
+    let i0 = ((alo * c0) as usize).min(coarse.0 - 1);
+    let i1 = ((ahi * c0).ceil() as usize).clamp(i0 + 1, coarse.0);
+    // coarse column j covers [j − ½, j + ½)/Cz; the fine interval may straddle 0
+    let j0 = (zlo * c1 + 0.5).floor() as i64;
+    let j1 = (zhi * c1 + 0.5).ceil() as i64;
+    for i in i0..i1 {
+        let da = (ahi.min((i + 1) as f64 / c0) - alo.max(i as f64 / c0)).max(0.0);
+        if da <= 0.0 {
+            continue;
+        }
+        for jj in j0..j1 {
+            let (clo, chi) = ((jj as f64 - 0.5) / c1, (jj as f64 + 0.5) / c1);
+            let dz = (zhi.min(chi) - zlo.max(clo)).max(0.0);
+            if dz > 0.0 {
+                let j = jj.rem_euclid(coarse.1 as i64) as usize;
+                out.push((i * coarse.1 + j, da * dz * f0 * f1));
+            }
+        }
+    }
+    out
 }
 
 /// Bin `k` of an `nalt × nazi` grid and its neighbours: one row up and down, one bin
@@ -205,6 +280,8 @@ pub struct Job<'a> {
     pub light: bool,
     /// The bins to sample (None: all); the others are left empty, for the caller to fill.
     pub only: Option<Vec<bool>>,
+    /// The `p+` refinement level (0: the first distribution): its rays' streams are its own.
+    pub level: u64,
     /// Progress (one unit per ray), if shown.
     pub progress: Option<&'a fenestra_cli::progress::Progress>,
 }
@@ -241,7 +318,8 @@ impl Job<'_> {
 
     /// The sampling stream and tracer ray index of ray `index` of this surface.
     pub fn stream(&self, index: u64) -> (Rng, u64) {
-        let id = (self.surface << 36) | index;
+        // the level in the top bits (surface numbers stay below 2^24)
+        let id = ((self.surface << 36) | index) ^ (self.level << 60);
         (Rng::for_ray(self.seed ^ 0x6d6b_696c_6c75_6d00, id), id)
     }
 
@@ -251,7 +329,7 @@ impl Job<'_> {
     /// from the window's top heading up meets the overhang, one from its foot may not);
     /// `rng` fills the digits below the 32nd. Order: the start point's two coordinates
     /// (the sequence's best-stratified pair), then the direction's altitude and azimuth.
-    fn cell_point(&self, k: usize, i: usize, rng: &mut Rng) -> [f64; 4] {
+    pub(crate) fn cell_point(&self, k: usize, i: usize, rng: &mut Rng) -> [f64; 4] {
         bin_point(self.seed, self.surface, k, i, rng)
     }
 
@@ -275,13 +353,8 @@ impl Job<'_> {
             }
             let l = -l;
             let k = flatindex(l, self.nalt, self.nazi);
-            if !self.picked(k) {
-                continue;
-            }
             let d = scale * l.z * s.omega;
-            for c in 0..3 {
-                dist.sums[k][c] += s.value[c] * d;
-            }
+            dist.add_light(k, s.value.map(|x| x * d));
         }
     }
 }
@@ -479,6 +552,12 @@ mod tests {
                 );
             }
         }
+        // nested grids: every coarse bin holds the centres of exactly four fine bins
+        let mut count = vec![0; coarse.0 * coarse.1];
+        for k in 0..fine.0 * fine.1 {
+            count[containing_bin(k, fine, coarse)] += 1;
+        }
+        assert!(count.iter().all(|&c| c == 4), "{count:?}");
         // the neighbourhood: 3 x 3 bins away from the pole (wrapping in azimuth), a whole
         // row at the pole
         let m = neighbourhood(3 * 22, (7, 22), false);
@@ -490,6 +569,44 @@ mod tests {
         // a sphere's last row is a pole too
         let m = neighbourhood(6 * 22 + 5, (7, 22), true);
         assert_eq!(m.iter().filter(|&&p| p).count(), 22 + 3);
+    }
+
+    #[test]
+    fn filling_spreads_each_coarse_bin_s_flux() {
+        // grids that do not nest (d=768 and d=3072): the overlap fractions of a fine bin
+        // sum to 1, every coarse bin's area is handed out whole, and a distribution filled
+        // from a coarser one keeps its flux (bins of a grid hold equal projected solid
+        // angles, so flux = sum / bins)
+        let (coarse, fine) = ((28, 88), (55, 173));
+        let nf = fine.0 * fine.1;
+        let mut given = vec![0.0; coarse.0 * coarse.1];
+        for k in 0..nf {
+            let o = overlaps(k, fine, coarse);
+            let total: f64 = o.iter().map(|x| x.1).sum();
+            assert!((total - 1.0).abs() < 1e-12, "fine bin {k}: {total}");
+            for (c, w) in o {
+                given[c] += w;
+            }
+        }
+        let per = nf as f64 / given.len() as f64;
+        for (c, g) in given.iter().enumerate() {
+            assert!((g - per).abs() < 1e-9 * per, "coarse bin {c}: {g} of {per}");
+        }
+        let mut rng = Rng::for_ray(4, 5);
+        let mut coarse_d = Distribution::new(coarse.0, coarse.1, 8);
+        for v in coarse_d.sums.iter_mut() {
+            *v = [rng.next_f64(), rng.next_f64(), 0.0];
+        }
+        let mut fine_d = Distribution::new(fine.0, fine.1, 8);
+        fine_d.fill_from(
+            &coarse_d,
+            &vec![false; nf],
+            &vec![false; coarse.0 * coarse.1],
+        );
+        let flux = |d: &Distribution| {
+            d.sums.iter().map(|v| v[0] + v[1]).sum::<f64>() / d.sums.len() as f64
+        };
+        assert!((flux(&fine_d) / flux(&coarse_d) - 1.0).abs() < 1e-12);
     }
 
     #[test]

@@ -29,8 +29,9 @@ pub struct XformOptions {
     pub xf_words: Vec<String>,
     /// The tool options as given, in order, with their values (the header repeats them).
     pub given: Vec<(String, Option<String>)>,
-    /// A run of one array element (its `name` is the element's, for the header).
-    pub element: bool,
+    /// A run of one array element: the element's name (`name.k`, `ak` without `-n`), which
+    /// the header gives for every `-n` value.
+    pub element: Option<String>,
 }
 
 /// Types whose string arguments end with an (appended) transform.
@@ -94,7 +95,8 @@ impl XformOptions {
                             Some(prev) => format!("{prev}.{v}"),
                             None => v.clone(),
                         });
-                    } else {
+                    } else if o.modifier.is_none() {
+                        // the first -m counts, as Radiance's
                         o.modifier = Some(v.clone());
                     }
                     o.given.push((args[i].clone(), Some(v)));
@@ -126,28 +128,24 @@ impl XformOptions {
     }
 
     /// The words after the program name in the header: the tool options as given (as
-    /// Radiance's: in their order, repeats kept; an array element's name in place of the
-    /// last `-n` value, or first when there was none), then the transform.
+    /// Radiance's: in their order, repeats kept; an array element's name in place of every
+    /// `-n` value, or first when there was none), then the transform.
     fn header_words(&self) -> Vec<String> {
         if self.given.is_empty() {
             return self.synthesised_header_words();
         }
         let mut w = Vec::new();
-        let last_n = self
-            .given
-            .iter()
-            .rposition(|(o, _)| o == "-n")
-            .filter(|_| self.element);
-        if let (None, true, Some(n)) = (last_n, self.element, &self.name) {
+        let has_n = self.given.iter().any(|(o, _)| o == "-n");
+        if let (false, Some(e)) = (has_n, &self.element) {
             w.push("-n".into());
-            w.push(n.clone());
+            w.push(e.clone());
         }
-        for (k, (o, v)) in self.given.iter().enumerate() {
+        for (o, v) in &self.given {
             w.push(o.clone());
-            match v {
-                Some(_) if Some(k) == last_n => w.push(self.name.clone().unwrap_or_default()),
-                Some(v) => w.push(v.clone()),
-                None => {}
+            match (v, &self.element) {
+                (Some(_), Some(e)) if o == "-n" => w.push(e.clone()),
+                (Some(v), _) => w.push(v.clone()),
+                (None, _) => {}
             }
         }
         w.extend(self.xf_words.iter().cloned());
@@ -238,15 +236,26 @@ impl Iterator for ArrayRuns<'_> {
             rest /= self.arrays[d].1;
         }
         let mut run = self.opts.clone();
-        let mut name = match &self.opts.name {
+        // the element's name: the last -n value's (Radiance's), `ak` without one
+        let given_n: Vec<&String> = self
+            .opts
+            .given
+            .iter()
+            .filter(|(o, _)| o == "-n")
+            .filter_map(|(_, v)| v.as_ref())
+            .collect();
+        let base = given_n.last().copied().or(self.opts.name.as_ref());
+        let mut name = match base {
             Some(n) => format!("{n}.{}", idx[0]),
             None => format!("a{}", idx[0]),
         };
         for k in &idx[1..] {
             let _ = write!(name, ".{k}");
         }
-        run.name = Some(name);
-        run.element = true;
+        // Radiance puts the element's name in place of every -n value, and a second -n
+        // extends the prefix: -n p -n q -a 2 names q.0.q.0.x (reproduced as such)
+        run.name = Some(vec![name.as_str(); given_n.len().max(1)].join("."));
+        run.element = Some(name);
         for (d, (pos, _)) in self.arrays.iter().enumerate() {
             run.xf_words[*pos] = "-i".into();
             run.xf_words[*pos + 1] = idx[d].to_string();
