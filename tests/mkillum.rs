@@ -51,6 +51,11 @@ fn colours(text: &str) -> Vec<[f64; 3]> {
         .collect()
 }
 
+/// The reference case's mkillum options (`../shared/reference/mkillum/commands.sh`).
+const REFERENCE_OPTS: [&str; 10] = [
+    "-n", "2", "-ab", "2", "-ad", "1024", "-aa", "0", "-lw", "1e-4",
+];
+
 fn ours(dir: &Path) -> Command {
     let mut c = common::fenestra("mkillum");
     c.current_dir(dir);
@@ -270,20 +275,7 @@ fn oracle_sobol_bins_are_less_noisy_than_radiance_s() {
         };
         let oct = common::run_ok(oconv.args(&scene).current_dir(&d));
         std::fs::write(d.join("scene.oct"), oct).unwrap();
-        mk.args([
-            "-n",
-            "2",
-            "-ab",
-            "2",
-            "-ad",
-            "1024",
-            "-aa",
-            "0",
-            "-lw",
-            "1e-4",
-            "scene.oct",
-        ])
-        .current_dir(&d);
+        mk.args(REFERENCE_OPTS).arg("scene.oct").current_dir(&d);
         let input = directive.replace("s=32", &format!("s={s}"));
         let out = String::from_utf8(common::pipe_ok(mk, input.as_bytes())).unwrap();
         direction_lums(&d, &out, "ill_glass")
@@ -325,23 +317,9 @@ fn reference_glass_window_distribution_and_proxy() {
     oconv.args(&scene);
     std::fs::write(dir.join("scene.oct"), common::run_ok(&mut oconv)).unwrap();
     let mut mk = ours(&dir);
-    mk.args([
-        "-n",
-        "2",
-        "-E",
-        "err.txt",
-        "-ab",
-        "2",
-        "-ad",
-        "1024",
-        "-aa",
-        "0",
-        "-lw",
-        "1e-4",
-        "scene.oct",
-        "<",
-    ])
-    .arg(fx("window_illum_glass.rad"));
+    mk.args(REFERENCE_OPTS)
+        .args(["-E", "err.txt", "scene.oct", "<"])
+        .arg(fx("window_illum_glass.rad"));
     let out = String::from_utf8(common::run_ok(&mut mk)).unwrap();
     let theirs = std::fs::read_to_string(fx("illum_glass.rad")).unwrap();
     // the header names the command: compare from the directive line on
@@ -636,23 +614,9 @@ fn reference_bsdf_window_colour_distribution_and_proxy() {
         assert!((a / b - 1.0).abs() < 0.02, "channel {ch}: {a} vs {b}");
     }
     let mut mk = ours(&dir);
-    mk.args([
-        "-n",
-        "2",
-        "-E",
-        "err.txt",
-        "-ab",
-        "2",
-        "-ad",
-        "1024",
-        "-aa",
-        "0",
-        "-lw",
-        "1e-4",
-        "scene.oct",
-        "<",
-    ])
-    .arg(fx("window_illum_bsdf.rad"));
+    mk.args(REFERENCE_OPTS)
+        .args(["-E", "err.txt", "scene.oct", "<"])
+        .arg(fx("window_illum_bsdf.rad"));
     let out = String::from_utf8(common::run_ok(&mut mk)).unwrap();
     let rad = std::fs::read_to_string(fx("illum_bsdf.rad")).unwrap();
     let (a, b) = (colours(&out)[0], colours(&rad)[0]);
@@ -762,19 +726,7 @@ fn bsdf_mode_lux_with(dir: &Path, sky: &str, xml: &str) -> Vec<f64> {
         .unwrap()
         .replace("d=100 s=32 f=win_ill", &format!("d={xml} s=64 f=ill_bmode"));
     let mut mk = ours(dir);
-    mk.args([
-        "-n",
-        "2",
-        "-ab",
-        "2",
-        "-ad",
-        "1024",
-        "-aa",
-        "0",
-        "-lw",
-        "1e-4",
-        "outside.oct",
-    ]);
+    mk.args(REFERENCE_OPTS).arg("outside.oct");
     let illum = common::pipe_ok(mk, input.as_bytes());
     std::fs::write(dir.join("illum.rad"), illum).unwrap();
     let mut oconv = common::fenestra("oconv");
