@@ -10,14 +10,8 @@
 # Usage: benches/genbsdf.sh [N]   (needs a testopt build of genBSDF and the oracle)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-[ -f .oracle/env ] || scripts/oracle.sh > /dev/null
-set -a; . .oracle/env; set +a
-export FENESTRA_NO_PROGRESS=1
 N=${1:-250}
-bin=$(realpath "${CARGO_TARGET_DIR:-target}/testopt")
-py="$PWD/.oracle/venv/bin/python"
-tmp=$(mktemp -d); [ -n "${KEEP:-}" ] || trap 'rm -rf "$tmp"' EXIT; echo "work: $tmp"
-"$FENESTRA_ORACLE_BIN/mgf2rad" tests/fixtures/genbsdf/blinds_curved20.mgf > "$tmp/blind.rad"
+. benches/genbsdf_blind.sh
 cd "$tmp"
 t0=$(date +%s.%N)
 PATH="$FENESTRA_ORACLE_BIN:$PATH" RAYPATH=".:$FENESTRA_ORACLE_LIB" "$py" - "$N" <<'PY' > oracle_totals.txt

@@ -15,16 +15,10 @@
 # Usage: benches/genbsdf_equal_error.sh [N] [K]   (default N = 450, K = 4; needs a testopt build and the oracle)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-[ -f .oracle/env ] || scripts/oracle.sh > /dev/null
-set -a; . .oracle/env; set +a
-export FENESTRA_NO_PROGRESS=1
 N=${1:-450}
 K=${2:-4}
 [ "$K" -ge 2 ] || { echo "genbsdf_equal_error.sh: K (replicates) must be at least 2" >&2; exit 2; }
-bin=$(realpath "${CARGO_TARGET_DIR:-target}/testopt")
-py="$PWD/.oracle/venv/bin/python"
-tmp=$(mktemp -d); [ -n "${KEEP:-}" ] || trap 'rm -rf "$tmp"' EXIT; echo "work: $tmp"
-"$FENESTRA_ORACLE_BIN/mgf2rad" tests/fixtures/genbsdf/blinds_curved20.mgf > "$tmp/blind.rad"
+. benches/genbsdf_blind.sh
 cd "$tmp"
 t0=$(date +%s.%N)
 PATH="$FENESTRA_ORACLE_BIN:$PATH" RAYPATH=".:$FENESTRA_ORACLE_LIB" "$py" - <<'PY'
