@@ -47,23 +47,36 @@ PY
 
 "$bin/oconv" materials.rad room.rad exterior.rad sky.rad skyfunc_glow.rad > outside.oct
 sed 's/d=100 s=32 f=ill_bsdf/d=blinds_kf.xml s=64 f=ill_bmode/' window_illum_bsdf.rad > window_illum_bmode.rad
+grep -q 'd=blinds_kf.xml' window_illum_bmode.rad || { echo "mkillum_pays.sh: the reference directive changed" >&2; exit 1; }
 for w in glass bsdf bmode; do
   # bmode: the BSDF window's proxy from its BSDF data (d=blinds_kf.xml s=64), sampled
   # outside the window (the room's outside, no window); rendered with the BSDF window
   win=$w; [ "$w" = bmode ] && win=bsdf
-  "$bin/oconv" materials.rad room.rad exterior.rad "window_$win.rad" sky.rad skyfunc_glow.rad > "$w.oct"
-  src="$w.oct"; [ "$w" = bmode ] && src=outside.oct
+  src=outside.oct
+  if [ "$w" != bmode ]; then
+    "$bin/oconv" materials.rad room.rad exterior.rad "window_$win.rad" sky.rad skyfunc_glow.rad > "$w.oct"
+    src="$w.oct"
+  fi
+  # each proxy its own data files (the directive's f= names them)
+  for s in $(seq 1 "$K"); do
+    sed "s/f=ill_$w/f=ill_${w}_$s/" "window_illum_$w.rad" > "win_${w}_$s.rad"
+  done
   t0=$(date +%s.%N)
   for s in $(seq 1 "$K"); do
-    # each proxy its own data files (the directive's f= names them)
-    sed "s/f=ill_$w/f=ill_${w}_$s/" "window_illum_$w.rad" > "win_${w}_$s.rad"
     "$bin/mkillum" -n 2 -seed "$s" -ab 2 -ad 1024 -aa 0 -lw 1e-4 "$src" < "win_${w}_$s.rad" > "ill_${w}_$s.rad"
-    "$bin/oconv" -f materials.rad room.rad exterior.rad "window_$win.rad" sky.rad skyfunc_glow.rad "ill_${w}_$s.rad" > "p_${w}_$s.oct"
   done
   t1=$(date +%s.%N)
+  for s in $(seq 1 "$K"); do
+    "$bin/oconv" -f materials.rad room.rad exterior.rad "window_$win.rad" sky.rad skyfunc_glow.rad "ill_${w}_$s.rad" > "p_${w}_$s.oct"
+  done
   : > "$w.txt"
   for ad in $ads; do
-    render none "$ad" "$w.oct" >> "$w.txt"
+    # the window without a proxy is the same for bsdf and bmode: rendered once
+    if [ "$w" = bmode ]; then
+      grep "^none $ad " bsdf.txt >> "$w.txt"
+    else
+      render none "$ad" "$w.oct" >> "$w.txt"
+    fi
     render proxy "$ad" "p_${w}_%s.oct" >> "$w.txt"
   done
   python3 - "$w" "$w.txt" "$(echo "($t1 - $t0) / $K" | bc -l)" <<'PY'

@@ -1,4 +1,4 @@
-# Sourced by benches/mkillum.sh and benches/mkillum_pays.sh from the checkout's root: the
+# Sourced by benches/mkillum.sh, mkillum_pays.sh and mkillum_equal_error.sh from the checkout's root: the
 # testopt binaries and library (bin, lib) and a temporary folder (tmp, removed on exit)
 # holding the reference mkillum room (../shared/reference/mkillum) with the BSDF window's XML.
 export FENESTRA_NO_PROGRESS=1

@@ -184,7 +184,7 @@ fn oracle_vwrays_stdin_positions() {
 /// A view so wide that the aspect adjustment leaves no row (or column): Radiance prints
 /// the empty resolution with -d (with -ld+ for a view with an aft plane, and also with -i),
 /// no rays otherwise, and succeeds; so do we (with a warning). Pixel positions read with -i
-/// would give NaN rays there: that stays an error.
+/// would give NaN rays there: that stays an error (empty_resolution_with_positions_fails).
 #[test]
 fn oracle_vwrays_resolution_reduced_to_nothing() {
     let Some(o) = common::oracle() else { return };
@@ -206,16 +206,17 @@ fn oracle_vwrays_resolution_reduced_to_nothing() {
         let theirs = common::run_ok(o.command("vwrays").args(args));
         assert_eq!(ours(args), theirs, "vwrays {args:?}");
     }
-    let out = common::run_stdin(
-        {
-            let mut c = common::fenestra("vwrays");
-            c.args([
-                "-i", "-x", "100", "-y", "1", "-vtv", "-vh", "90", "-vv", "0.1",
-            ]);
-            c
-        },
-        b"5 0\n",
-    );
+}
+
+/// Pixel positions read (-i) for a view whose aspect leaves no row: an error naming the
+/// resolution, and no rays (Radiance writes NaN rays).
+#[test]
+fn empty_resolution_with_positions_fails() {
+    let mut c = common::fenestra("vwrays");
+    c.args([
+        "-i", "-x", "100", "-y", "1", "-vtv", "-vh", "90", "-vv", "0.1",
+    ]);
+    let out = common::run_stdin(c, b"5 0\n");
     assert!(!out.status.success() && out.stdout.is_empty());
     assert!(String::from_utf8_lossy(&out.stderr).contains("100 x 0"));
 }

@@ -62,18 +62,8 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         Some("-a") => {
             let mut r = stdin_reader();
             let h = Header::read(&mut r, "<stdin>")?;
-            let is_format = |l: &str| l.starts_with("FORMAT=");
-            for l in h.lines.iter().filter(|l| !is_format(l)) {
-                writeln!(out, "{l}")?;
-            }
-            for l in &rest[1..] {
-                writeln!(out, "{l}")?;
-            }
-            // The data format line goes last, rewritten without padding (as Radiance).
-            if let Some(f) = h.format() {
-                writeln!(out, "FORMAT={f}")?;
-            }
-            writeln!(out)?;
+            // the data format line goes last, rewritten without padding (as Radiance)
+            h.write_adding(&mut out, &rest[1..])?;
             std::io::copy(&mut r, &mut out).context("cannot copy the data")?;
             true
         }
@@ -147,18 +137,11 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
 fn run_command(out: &mut impl Write, dim: Option<bool>, command: &[String]) -> Result<ExitCode> {
     let mut r = stdin_reader();
     let h = Header::read(&mut r, "<stdin>")?;
-    for l in h.lines.iter().filter(|l| !l.starts_with("FORMAT=")) {
-        writeln!(out, "{l}")?;
-    }
     let words: Vec<String> = command
         .iter()
         .map(|w| fenestra_cli::quote_word(w))
         .collect();
-    writeln!(out, "{}", words.join(" "))?;
-    if let Some(f) = h.format() {
-        writeln!(out, "FORMAT={f}")?;
-    }
-    writeln!(out)?;
+    h.write_adding(out, &[words.join(" ")])?;
     if let Some(keep) = dim {
         let res = read_resolution(&mut r, "<stdin>")?;
         if keep {

@@ -120,43 +120,38 @@ pub fn run(args: Vec<String>) -> Result<ExitCode> {
         None
     };
     view.setup().map_err(|e| anyhow::anyhow!("{e}"))?;
-    let res = match res {
-        Some(r) => r,
+    // the resolution: the picture's, or the one asked for as the view's aspect leaves it
+    // (which can be no row or column)
+    let (xr, yr) = match &res {
+        Some(r) => (r.xr as i64, r.yr as i64),
         None => {
             normaspect(view.aspect(), &mut pa, &mut xres, &mut yres);
-            if xres <= 0 || yres <= 0 {
-                // Radiance prints the empty resolution (-d, even with -i) or no rays, and
-                // succeeds; rays for pixel positions read (-i) would be NaN there, so that
-                // stays an error
-                if getdim {
-                    println!(
-                        "-x {} -y {}{}",
-                        xres.max(0),
-                        yres.max(0),
-                        if view.vaft > FTINY { " -ld+" } else { "" }
-                    );
-                    return Ok(ExitCode::SUCCESS);
-                }
-                if from_stdin {
-                    bail!("view aspect reduces the resolution to {xres} x {yres}");
-                }
-                fenestra_cli::warn(format!(
-                    "view aspect reduces the resolution to {xres} x {yres}: no rays"
-                ));
-                return Ok(ExitCode::SUCCESS);
-            }
-            Resolution::standard(xres as usize, yres as usize)
+            (xres.max(0), yres.max(0))
         }
     };
     if getdim {
+        // Radiance prints even an empty resolution (also with -i)
         println!(
-            "-x {} -y {}{}",
-            res.xr,
-            res.yr,
+            "-x {xr} -y {yr}{}",
             if view.vaft > FTINY { " -ld+" } else { "" }
         );
         return Ok(ExitCode::SUCCESS);
     }
+    let res = match res {
+        Some(r) => r,
+        None if xr > 0 && yr > 0 => Resolution::standard(xr as usize, yr as usize),
+        None => {
+            // Radiance writes no rays and succeeds; rays for pixel positions read (-i)
+            // would be NaN there, so that stays an error
+            if from_stdin {
+                bail!("view aspect reduces the resolution to {xres} x {yres}");
+            }
+            fenestra_cli::warn(format!(
+                "view aspect reduces the resolution to {xres} x {yres}: no rays"
+            ));
+            return Ok(ExitCode::SUCCESS);
+        }
+    };
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::with_capacity(1 << 16, stdout.lock());
     if from_stdin {

@@ -216,6 +216,26 @@ impl Header {
         w.write_all(b"\n")
     }
 
+    /// Writes the header with `added` lines after its own and its `FORMAT=` line moved last
+    /// (rewritten without padding), then the terminating empty line, as Radiance's
+    /// `getinfo -a` and `-c` do.
+    pub fn write_adding<W: Write + ?Sized>(
+        &self,
+        w: &mut W,
+        added: &[String],
+    ) -> std::io::Result<()> {
+        for l in self.lines.iter().filter(|l| !l.starts_with("FORMAT=")) {
+            writeln!(w, "{l}")?;
+        }
+        for l in added {
+            writeln!(w, "{l}")?;
+        }
+        if let Some(f) = self.format() {
+            writeln!(w, "FORMAT={f}")?;
+        }
+        w.write_all(b"\n")
+    }
+
     /// Writes the lines only (no terminating empty line).
     pub fn write_lines<W: Write + ?Sized>(&self, w: &mut W) -> std::io::Result<()> {
         for l in &self.lines {
