@@ -208,7 +208,7 @@ pub(crate) fn sides(opts: &Options) -> Vec<(bool, Direction, Direction)> {
 
 /// The scramble seeds of one incident direction (`key`) under `seed`, one per coordinate of
 /// [`sample_start`]'s Sobol points.
-pub(crate) fn scramble_seeds(seed: u64, key: u64) -> [u64; 4] {
+pub(crate) fn direction_seeds(seed: u64, key: u64) -> [u64; 4] {
     fenestra_trace::sobol::scramble_seeds(seed ^ 0x736f_626f_6c34, key)
 }
 
@@ -221,7 +221,7 @@ pub(crate) fn scramble_seeds(seed: u64, key: u64) -> [u64; 4] {
 /// two slats depends on where it starts across them and on its direction together, and a
 /// joint stratification estimates that fraction far better than independently stratified
 /// start points and directions paired at random. The scramble (`seeds`, from
-/// [`scramble_seeds`] of the incident direction) keeps every sample uniform, so the mean
+/// [`direction_seeds`] of the incident direction) keeps every sample uniform, so the mean
 /// stays unbiased; `rng` (the sample's own stream) fills the digits below the 32nd.
 pub(crate) fn sample_start(
     seeds: [u64; 4],
@@ -364,7 +364,7 @@ pub fn characterise_with(
                     let mut sz = sx.clone();
                     let mut hits: Vec<(usize, f64)> = Vec::new();
                     let key = (side_k * np + i) as u64;
-                    let seeds = scramble_seeds(seed, key);
+                    let seeds = direction_seeds(seed, key);
                     for k in 0..n {
                         hits.clear();
                         let index = (key * n as u64) + k as u64;

@@ -18,7 +18,7 @@ use rayon::prelude::*;
 use crate::reduce::{reciprocity, reduce, Grid};
 use crate::reduce_stream::{Rows, StreamReduce};
 use crate::{
-    add_squares, grid, sample_seed, sample_start, scramble_seeds, setup, sides, Characterised,
+    add_squares, direction_seeds, grid, sample_seed, sample_start, setup, sides, Characterised,
     Options, Setup,
 };
 
@@ -189,7 +189,7 @@ pub fn characterise(
             let mut sq = vec![0.0; if opts.errors { 2 * ncell } else { 0 }];
             let mut hits: Vec<(usize, f64)> = Vec::new();
             let key = (side_k * nin + cell) as u64;
-            let seeds = scramble_seeds(seed, key);
+            let seeds = direction_seeds(seed, key);
             for k in 0..ns {
                 hits.clear();
                 let index = key * ns as u64 + k as u64;

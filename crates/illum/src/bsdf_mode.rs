@@ -115,21 +115,9 @@ pub fn face(
     let s = job.nsamps;
     let ni = bsdf.incident.len();
     let eps = 0.005 * f.area.sqrt();
-    // a point uniform over the window: the first candidate from (x, y) in [0,1)² over its
-    // (u, v) box, later ones (rejection) from `rng`
-    let point = |(x, y): (f64, f64), rng: &mut fenestra_trace::rng::Rng| -> Option<DVec3> {
-        let (mut x, mut y) = (x, y);
-        for t in 0..1000 {
-            if t > 0 {
-                (x, y) = (rng.next_f64(), rng.next_f64());
-            }
-            let a = f.ur[0] + (f.ur[1] - f.ur[0]) * x;
-            let b = f.vr[0] + (f.vr[1] - f.vr[0]) * y;
-            if f.contains(a, b) {
-                return Some(f.point(a, b) - eps * n);
-            }
-        }
-        None
+    // a point uniform over the window (Face::uniform_point), moved outward
+    let point = |xy: (f64, f64), rng: &mut fenestra_trace::rng::Rng| -> Option<DVec3> {
+        f.uniform_point(xy, rng, 1000).0.map(|q| q - eps * n)
     };
     // radiance arriving from outside, per incident patch (sources not seen directly)
     let rays: Vec<Option<(usize, [f64; 3])>> = (0..ni * s)
@@ -164,16 +152,8 @@ pub fn face(
         .into_par_iter()
         .map(|k| {
             let (mut rng, id) = job.stream((ni * s + k) as u64);
-            let (a0, b0) = stratified2(k, npts, &mut rng);
-            let (a, b) = (
-                f.ur[0] + (f.ur[1] - f.ur[0]) * a0,
-                f.vr[0] + (f.vr[1] - f.vr[0]) * b0,
-            );
-            let org = if f.contains(a, b) {
-                f.point(a, b) - eps * n
-            } else {
-                point((rng.next_f64(), rng.next_f64()), &mut rng)?
-            };
+            let xy = stratified2(k, npts, &mut rng);
+            let org = point(xy, &mut rng)?;
             let mut out = Vec::new();
             for src in job.tracer.source_light(id, org) {
                 let c = -src.dir.dot(n);

@@ -9,7 +9,7 @@ use fenestra_trace::Tracer;
 
 use crate::directives::Settings;
 use crate::geometry::{Face, Ring};
-use crate::sample::{self, Job};
+use crate::sample::{self, Job, Shape};
 use crate::write::{self, Prim};
 
 /// Where output goes.
@@ -319,16 +319,27 @@ impl<'a> Filter<'a> {
             .and_then(|f| self.bsdfs.get(f))
             .cloned();
         if let Some(data) = bsdf {
-            let job = self.job(p, self.settings.sampdens, Some(data.incident.len()), 0);
+            let job = self.job(
+                p,
+                self.settings.sampdens,
+                Some(data.incident.len()),
+                0,
+                None,
+            );
             return self.convert_bsdf(p, name, out, &job, &data);
         }
         let keep = self.settings.sampdens;
         let mut dens = keep;
-        let job = self.job(p, dens, None, 0);
-        let Some((mut dist, axes)) = self.sample_traced(p, name, out, &job)? else {
+        let Some(shape) = self.shape_of(p, name, out)? else {
             return Ok(());
         };
-        let sphere = p.ptype == "sphere";
+        let job = self.job(p, dens, None, 0, None);
+        let Some(mut dist) = shape.sample(&job) else {
+            self.pass_unchanged(p, out, &format!("polygon \"{}\": bad aspect", p.name), name);
+            return Ok(());
+        };
+        let axes = shape.axes();
+        let sphere = matches!(shape, Shape::Sphere(..));
         let mut level = 0;
         let peak = loop {
             let peak = if dens > 0 { dist.peak() } else { None };
@@ -339,8 +350,7 @@ impl<'a> Filter<'a> {
                 Some((share, at)) if refine => {
                     level += 1;
                     let around = sample::neighbourhood(at, (dist.nalt, dist.nazi), sphere);
-                    let mut fine = self.job(p, dens * 4, None, level);
-                    let grid = (fine.nalt, fine.nazi);
+                    let grid = self.divisions(p, dens * 4);
                     let picked: Vec<bool> = (0..grid.0 * grid.1)
                         .map(|k| around[sample::containing_bin(k, grid, (dist.nalt, dist.nazi))])
                         .collect();
@@ -353,12 +363,9 @@ impl<'a> Filter<'a> {
                         dens * 4,
                         picked.iter().filter(|&&x| x).count()
                     ));
-                    fine.only = Some(picked.clone());
-                    if let Some(pr) = self.progress {
-                        pr.restart(fine.rays() as u64, &format!("mkillum {}", p.name));
-                    }
+                    let fine = self.job(p, dens * 4, None, level, Some(picked.clone()));
                     // origins that cannot be placed this time keep the distribution so far
-                    let Some(mut finer) = self.sample_refined(p, name, &fine)? else {
+                    let Some(mut finer) = shape.sample(&fine) else {
                         warn(format!(
                             "{} \"{}\": refinement at d={} failed (bad aspect): kept d={dens}",
                             p.ptype,
@@ -381,14 +388,28 @@ impl<'a> Filter<'a> {
         r
     }
 
-    /// The sampling job of surface number `self.surfaces` (`p`) at density `dens`;
-    /// `bsdf_patches`: the incident patches of the BSDF-data mode (for the progress bar).
-    /// `level`: the refinement level (`p+`), which keys streams of its own.
-    fn job(&self, p: &Prim, dens: i64, bsdf_patches: Option<usize>, level: u64) -> Job<'a> {
-        let (nalt, nazi) = match p.ptype.as_str() {
+    /// Altitude and azimuth divisions of `p`'s distribution at density `dens`.
+    fn divisions(&self, p: &Prim, dens: i64) -> (usize, usize) {
+        match p.ptype.as_str() {
             "sphere" => crate::directives::round_divisions(dens),
             _ => crate::directives::flat_divisions(dens),
-        };
+        }
+    }
+
+    /// The sampling job of surface number `self.surfaces` (`p`) at density `dens`, its
+    /// progress bar restarted; `bsdf_patches`: the incident patches of the BSDF-data mode.
+    /// `level`: the refinement level (`p+`), which keys streams of its own (in the seed of
+    /// the sampling streams here, in the tracer's ray ids in [`Job::stream`]); `only`: the
+    /// bins to sample (all when None).
+    fn job(
+        &self,
+        p: &Prim,
+        dens: i64,
+        bsdf_patches: Option<usize>,
+        level: u64,
+        only: Option<Vec<bool>>,
+    ) -> Job<'a> {
+        let (nalt, nazi) = self.divisions(p, dens);
         let nsamps = self.settings.nsamps.max(1) as usize;
         let job = Job {
             tracer: self.tracer,
@@ -398,86 +419,43 @@ impl<'a> Filter<'a> {
             nazi,
             nsamps,
             light: self.settings.light,
-            only: None,
+            only,
             level,
             progress: self.progress,
         };
         if let Some(pr) = self.progress {
             let rays = match bsdf_patches {
                 Some(np) => np * nsamps,
-                None => nalt * nazi * nsamps,
+                None => job.rays(),
             };
             pr.restart(rays as u64, &format!("mkillum {}", p.name));
         }
         job
     }
 
-    /// A `p+` refinement's distribution of `p` (already sampled once, so its kind and
-    /// geometry are good), or `None` when its origins could not be placed.
-    fn sample_refined(
-        &self,
-        p: &Prim,
-        name: &str,
-        job: &Job,
-    ) -> Result<Option<crate::sample::Distribution>> {
+    /// The surface `p` as a shape to sample, or `None` when it is passed on unchanged (a
+    /// zero-area polygon, a surface of another kind).
+    fn shape_of(&mut self, p: &Prim, name: &str, out: &mut String) -> Result<Option<Shape>> {
         Ok(match p.ptype.as_str() {
-            "polygon" => {
-                let face = Face::new(&p.rargs)
-                    .map_err(|e| anyhow::anyhow!("({name}): polygon \"{}\": {e}", p.name))?;
-                face.and_then(|f| sample::face(job, &f))
-            }
+            "polygon" => self.face_of(p, name, out)?.map(Shape::Face),
             "ring" => {
-                let r = Ring::new(&p.rargs)
-                    .map_err(|e| anyhow::anyhow!("({name}): ring \"{}\": {e}", p.name))?;
-                Some(sample::ring(job, &r))
-            }
-            _ => {
-                let c = glam::DVec3::new(p.rargs[0], p.rargs[1], p.rargs[2]);
-                Some(sample::sphere(job, c, p.rargs[3]))
-            }
-        })
-    }
-
-    /// The traced mode's distribution of `p` (with its axes), or `None` when the surface
-    /// was passed on unchanged.
-    fn sample_traced(
-        &mut self,
-        p: &Prim,
-        name: &str,
-        out: &mut String,
-        job: &Job,
-    ) -> Result<Option<(crate::sample::Distribution, Option<[glam::DVec3; 3]>)>> {
-        // the distribution, or why the surface is passed on unchanged
-        let sampled = match p.ptype.as_str() {
-            "polygon" => {
-                let Some(face) = self.face_of(p, name, out)? else {
-                    return Ok(None);
-                };
-                sample::face(job, &face)
-                    .map(|d| (d, Some([face.u, face.v, face.norm])))
-                    .ok_or_else(|| format!("polygon \"{}\": bad aspect", p.name))
-            }
-            "ring" => {
-                let r = Ring::new(&p.rargs)
-                    .map_err(|e| anyhow::anyhow!("({name}): ring \"{}\": {e}", p.name))?;
-                Ok((sample::ring(job, &r), Some([r.u, r.v, r.axis])))
+                Some(Shape::Ring(Ring::new(&p.rargs).map_err(|e| {
+                    anyhow::anyhow!("({name}): ring \"{}\": {e}", p.name)
+                })?))
             }
             "sphere" => {
                 if p.rargs.len() != 4 {
                     bail!("({name}): sphere \"{}\": bad # of arguments", p.name);
                 }
                 let c = glam::DVec3::new(p.rargs[0], p.rargs[1], p.rargs[2]);
-                Ok((sample::sphere(job, c, p.rargs[3]), None))
+                Some(Shape::Sphere(c, p.rargs[3]))
             }
-            other => Err(format!("cannot make illum for {other} \"{}\"", p.name)),
-        };
-        match sampled {
-            Ok(s) => Ok(Some(s)),
-            Err(why) => {
+            other => {
+                let why = format!("cannot make illum for {other} \"{}\"", p.name);
                 self.pass_unchanged(p, out, &why, name);
-                Ok(None)
+                None
             }
-        }
+        })
     }
 
     /// BSDF-data mode (`d=file.xml`) for one surface.

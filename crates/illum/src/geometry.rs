@@ -109,6 +109,30 @@ impl Face {
         a * self.u + b * self.v + self.offset * self.norm
     }
 
+    /// A point uniform over the polygon: the first candidate from (`x`, `y`) in [0,1)² over
+    /// its (u, v) box, the later ones (rejection) from `rng`, at most `tries` in all; each
+    /// accepted point is uniform over the polygon whichever try it came from. Also the
+    /// number of candidates rejected (`tries` when none was kept).
+    pub fn uniform_point(
+        &self,
+        (x, y): (f64, f64),
+        rng: &mut fenestra_trace::rng::Rng,
+        tries: usize,
+    ) -> (Option<DVec3>, usize) {
+        let (mut x, mut y) = (x, y);
+        for t in 0..tries {
+            if t > 0 {
+                (x, y) = (rng.next_f64(), rng.next_f64());
+            }
+            let a = self.ur[0] + (self.ur[1] - self.ur[0]) * x;
+            let b = self.vr[0] + (self.vr[1] - self.vr[0]) * y;
+            if self.contains(a, b) {
+                return (Some(self.point(a, b)), t);
+            }
+        }
+        (None, tries)
+    }
+
     /// Whether in-plane coordinates (a, b) fall inside the polygon (crossing count).
     pub fn contains(&self, a: f64, b: f64) -> bool {
         let n = self.pts.len();

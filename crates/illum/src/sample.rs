@@ -359,28 +359,44 @@ impl Job<'_> {
     }
 }
 
+/// A surface mkillum samples, parsed once for every refinement level.
+pub enum Shape {
+    /// A polygon.
+    Face(Face),
+    /// A ring.
+    Ring(Ring),
+    /// A sphere: centre and radius.
+    Sphere(DVec3, f64),
+}
+
+impl Shape {
+    /// The distribution `job` asks for; `None` when a polygon's origins could not be
+    /// placed ("bad aspect").
+    pub fn sample(&self, job: &Job) -> Option<Distribution> {
+        match self {
+            Shape::Face(f) => face(job, f),
+            Shape::Ring(r) => Some(ring(job, r)),
+            Shape::Sphere(c, radius) => Some(sphere(job, *c, *radius)),
+        }
+    }
+
+    /// The distribution's frame (u, v, normal) of a flat surface; None for a sphere.
+    pub fn axes(&self) -> Option<[DVec3; 3]> {
+        match self {
+            Shape::Face(f) => Some([f.u, f.v, f.norm]),
+            Shape::Ring(r) => Some([r.u, r.v, r.axis]),
+            Shape::Sphere(..) => None,
+        }
+    }
+}
+
 /// A polygon's distribution; `None` when origins could not be placed ("bad aspect").
 pub fn face(job: &Job, f: &Face) -> Option<Distribution> {
     let n = job.nalt * job.nazi;
     let s = job.nsamps;
     let eps = R_EPS * f.area.sqrt();
-    // A start point uniform over the polygon: the first candidate from (`x`, `y`) in
-    // [0,1)² over the polygon's (u, v) box, the later ones (rejection) from `rng`; each
-    // accepted point is uniform over the polygon whichever try it came from.
-    let origin = |(x, y): (f64, f64), rng: &mut Rng| -> (Option<DVec3>, usize) {
-        let (mut x, mut y) = (x, y);
-        for t in 0..MAX_TRIES {
-            if t > 0 {
-                (x, y) = (rng.next_f64(), rng.next_f64());
-            }
-            let a = f.ur[0] + (f.ur[1] - f.ur[0]) * x;
-            let b = f.vr[0] + (f.vr[1] - f.vr[0]) * y;
-            if f.contains(a, b) {
-                return (Some(f.point(a, b)), t);
-            }
-        }
-        (None, MAX_TRIES)
-    };
+    // a start point uniform over the polygon (Face::uniform_point)
+    let origin = |xy: (f64, f64), rng: &mut Rng| f.uniform_point(xy, rng, MAX_TRIES);
     let rays: Vec<(usize, [f64; 3], usize)> = (0..n * s)
         .into_par_iter()
         .filter(|idx| job.picked(idx / s))
@@ -607,6 +623,42 @@ mod tests {
             d.sums.iter().map(|v| v[0] + v[1]).sum::<f64>() / d.sums.len() as f64
         };
         assert!((flux(&fine_d) / flux(&coarse_d) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn filling_leaves_out_the_resampled_bins_and_the_coarse_sources() {
+        // d=48 -> d=192: one coarse bin resampled (value 1e6, the peak), every other with
+        // rays worth 1 per bin plus a light-source part; the fine grid's own source part is
+        // 0.25 everywhere. A fine bin not picked must get exactly 1 (rays, the peak left out)
+        // + 0.25 (its own sources), whatever coarse sources it overlaps.
+        let (coarse, fine) = ((7, 22), (14, 44));
+        let nc = coarse.0 * coarse.1;
+        let peak = 3 * 22 + 5;
+        let mut c = Distribution::new(coarse.0, coarse.1, 4);
+        let mut rng = Rng::for_ray(6, 7);
+        for k in 0..nc {
+            let l = 5.0 * rng.next_f64();
+            c.lights[k] = [l; 3];
+            c.sums[k] = [if k == peak { 1e6 } else { 1.0 + l }; 3];
+        }
+        let resampled: Vec<bool> = (0..nc).map(|k| k == peak).collect();
+        let picked: Vec<bool> = (0..fine.0 * fine.1)
+            .map(|k| resampled[containing_bin(k, fine, coarse)])
+            .collect();
+        assert!(picked.iter().any(|&p| p) && picked.iter().any(|&p| !p));
+        let mut f = Distribution::new(fine.0, fine.1, 4);
+        f.lights = vec![[0.25; 3]; fine.0 * fine.1];
+        f.sums = f.lights.clone();
+        f.fill_from(&c, &picked, &resampled);
+        for (k, &p) in picked.iter().enumerate() {
+            if !p {
+                assert!(
+                    (f.sums[k][0] - 1.25).abs() < 1e-12,
+                    "fine bin {k}: {:?}",
+                    f.sums[k]
+                );
+            }
+        }
     }
 
     #[test]
