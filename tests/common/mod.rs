@@ -279,13 +279,13 @@ pub fn direct_both(
     let mut c = oracle.command("rtrace");
     c.args(["-h", "-aa", "0", "-ab", "0", "-ss", "0", "scene.oct"])
         .current_dir(dir);
-    let theirs = numbers(&run_stdin(c, rays.as_bytes()).stdout);
+    let theirs = numbers(&pipe_ok(c, rays.as_bytes()));
     let mut c = fenestra("rtrace");
     c.args(["-h", "-ab", "0", "-ss", "0"])
         .args(scene)
         .current_dir(dir);
     c.env("RAYPATH", dir);
-    let ours = numbers(&run_stdin(c, rays.as_bytes()).stdout);
+    let ours = numbers(&pipe_ok(c, rays.as_bytes()));
     assert_eq!(theirs.len(), ours.len());
     (theirs, ours)
 }
