@@ -24,19 +24,14 @@ PY
 t1=$(date +%s.%N)
 "$bin/genBSDF" -n 2 -c "$N" +f +b blind.rad > ours.xml
 t2=$(date +%s.%N)
-python3 - "$t0" "$t1" "$t2" <<'PY'
+PYTHONPATH="$benches" python3 - "$t0" "$t1" "$t2" <<'PY'
 import math, sys
 t0, t1, t2 = map(float, sys.argv[1:])
 print(f"oracle genBSDF (pyradiance) {t1-t0:.1f} s, fenestra {t2-t1:.1f} s, ratio {(t1-t0)/(t2-t1):.2f}x")
 # the oracle's matrices are rmtxop -t of rfluxmtx output: rows = outgoing patch, columns = incident
 # patch, each a fraction of the incident flux (wrapBSDF divides by the outgoing patch's projected
 # solid angle later); diffuse-incidence total = sum_o sum_i lam_i f[o][i] / pi
-edges = [0, 5, 15, 25, 35, 45, 55, 65, 75, 90]
-counts = [1, 8, 16, 20, 24, 24, 24, 16, 12]
-lam = []
-for r, n in enumerate(counts):
-    a, b = math.radians(edges[r]), math.radians(edges[r + 1])
-    lam += [math.pi * (math.sin(b) ** 2 - math.sin(a) ** 2) / n] * n
+from klems_lam import LAM as lam
 for name, f in [("Int->Ext Trans", "oracle_back_T.txt"), ("Interior Refl", "oracle_back_R.txt")]:
     rows = [list(map(float, l.split())) for l in open(f) if l.strip()]
     tot = sum(lam[i] * rows[o][i] for i in range(145) for o in range(145)) / math.pi

@@ -42,16 +42,11 @@ t1b=$(date +%s.%N)
 "$bin/genBSDF" -q -n 2 -c "$N" +C +f +b blind.rad > ours.xml
 t2=$(date +%s.%N)
 for s in $(seq 1 "$K"); do "$bin/genBSDF" -q -n 2 -c "$N" -r "-seed $s" blind.rad > "rep_$s.xml"; done
-python3 - "$t0" "$t1" "$t1b" "$t2" "$N" rep_*.xml <<'PY'
+PYTHONPATH="$benches" python3 - "$t0" "$t1" "$t1b" "$t2" "$N" rep_*.xml <<'PY'
 import math, re, sys
 t0, t1, t1b, t2 = map(float, sys.argv[1:5])
 n, reps = sys.argv[5], sys.argv[6:]
-edges = [0, 5, 15, 25, 35, 45, 55, 65, 75, 90]
-counts = [1, 8, 16, 20, 24, 24, 24, 16, 12]
-lam = []
-for r, c in enumerate(counts):
-    a, b = math.radians(edges[r]), math.radians(edges[r + 1])
-    lam += [math.pi * (math.sin(b) ** 2 - math.sin(a) ** 2) / c] * c
+from klems_lam import LAM as lam
 N = 145
 
 def xml_fractions(path):
